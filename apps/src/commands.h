@@ -1,0 +1,16 @@
+#pragma once
+// Each subcommand lives in its own cmd_<name>.cpp and registers itself on the root app.
+// A command's callback does the work and reports failure by throwing tomorig::Error;
+// main.cpp maps errors to exit codes in one place (see docs/cli.md):
+//   0 ok, 1 runtime failure, 2 bad usage or bad input.
+#include <CLI/CLI.hpp>
+
+namespace tomorig::app {
+
+void add_config_command(CLI::App& root);    // cmd_config.cpp: config check | default
+void add_simulate_command(CLI::App& root);  // cmd_simulate.cpp
+void add_inspect_command(CLI::App& root);   // cmd_inspect.cpp
+void add_import_command(CLI::App& root);    // cmd_import.cpp
+void add_run_command(CLI::App& root);       // cmd_run.cpp: the main job on a rig config
+
+}  // namespace tomorig::app

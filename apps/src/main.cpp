@@ -1,0 +1,45 @@
+// tomorig: the command line. Parses flags, calls the libraries, prints, and maps errors to
+// exit codes here and nowhere else.
+#include <cstdio>
+#include <exception>
+
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+
+#include "commands.h"
+#include "exit_codes.h"
+#include "tomorig/core/error.h"
+#include "tomorig/core/version.h"
+
+int main(int argc, char** argv) {
+  using namespace tomorig::app;
+  CLI::App app{"tomorig: tomographic PIV and shadowgraphy acquisition and processing"};
+  app.set_version_flag("--version", std::string(tomorig::software_version()));
+  app.require_subcommand(1);
+  app.footer("Exit codes: 0 ok, 1 runtime failure, 2 bad usage or bad input.\n"
+             "Run 'tomorig <command> --help' for a command's options.");
+  add_run_command(app);
+  add_simulate_command(app);
+  add_import_command(app);
+  add_inspect_command(app);
+  add_config_command(app);
+
+  try {
+    app.parse(argc, argv);
+    return kExitOk;
+  } catch (const CLI::Success& e) {  // --help, --version
+    app.exit(e);
+    return kExitOk;
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kExitBadInput;
+  } catch (const tomorig::Error& e) {
+    std::fflush(stdout);
+    fmt::print(stderr, "error: {}\n", e.what());
+    return e.kind() == tomorig::ErrorKind::bad_input ? kExitBadInput : kExitRuntimeFailure;
+  } catch (const std::exception& e) {
+    std::fflush(stdout);
+    fmt::print(stderr, "error: {}\n", e.what());
+    return kExitRuntimeFailure;
+  }
+}

@@ -1,0 +1,28 @@
+# Every third-party dependency is found here, once. The Debian packages that provide them are
+# listed in scripts/apt-packages.txt.
+find_package(PkgConfig REQUIRED)
+find_package(Threads REQUIRED)
+find_package(OpenMP REQUIRED COMPONENTS CXX)
+find_package(Eigen3 3.4 REQUIRED NO_MODULE)
+find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc imgcodecs)
+find_package(HDF5 REQUIRED COMPONENTS C)
+find_package(tomlplusplus REQUIRED)
+find_package(CLI11 REQUIRED)
+find_package(nlohmann_json 3 REQUIRED)
+find_package(fmt REQUIRED)
+find_package(spdlog REQUIRED)
+if(TOMORIG_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+endif()
+if(TOMORIG_BUILD_BENCH)
+  find_package(benchmark REQUIRED)
+endif()
+
+# HDF5's CMake config on Debian exposes variables, not a target; wrap them once.
+if(NOT TARGET tomorig::hdf5)
+  add_library(tomorig_hdf5 INTERFACE)
+  target_include_directories(tomorig_hdf5 SYSTEM INTERFACE ${HDF5_INCLUDE_DIRS})
+  target_link_libraries(tomorig_hdf5 INTERFACE ${HDF5_C_LIBRARIES})
+  target_compile_definitions(tomorig_hdf5 INTERFACE ${HDF5_DEFINITIONS})
+  add_library(tomorig::hdf5 ALIAS tomorig_hdf5)
+endif()

@@ -1,0 +1,111 @@
+#pragma once
+// The rig configuration: cameras, trigger, calibration, voxel grid, processing and the
+// simulated scene. Parsed from TOML by load_rig_config(); every value is validated and every
+// error names the key path and line. toml++ stays inside config/src.
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tomorig/core/pixel_format.h"
+
+namespace tomorig::config {
+
+enum class CameraBackend : std::uint8_t { aravis, simulated };
+enum class TriggerBackend : std::uint8_t { gpio, simulated };
+
+struct Roi {
+  int offset_x = 0, offset_y = 0;
+  int width = 0, height = 0;  // pixels
+};
+
+struct CameraConfig {
+  std::string id;                               // unique, e.g. "cam0"
+  CameraBackend backend = CameraBackend::simulated;
+  std::string device_id;                        // Aravis device id; for simulated: the view name
+  std::map<std::string, std::string> features;  // extra GenICam features, applied verbatim
+  Roi roi;
+  PixelFormat pixel_format = PixelFormat::Mono16;
+  double pixel_pitch_um = 7.4;
+  // Simulated cameras only: pinhole placement (see simulators/).
+  double yaw_deg = 0.0;
+  double focal_length_mm = 100.0;
+  double distance_mm = 263.16;
+};
+
+struct TriggerChannel {
+  std::string name;      // e.g. "laser1", "cam_trigger"
+  std::string role;      // "light" | "camera"
+  std::string chip;      // GPIO chip for the gpio backend, e.g. "gpiochip0"
+  int line = -1;         // GPIO line offset
+};
+
+struct TriggerConfig {
+  TriggerBackend backend = TriggerBackend::simulated;
+  double rate_hz = 10.0;          // repetition rate of double-frame events
+  double dt_us = 100.0;           // pulse separation
+  double pulse_width_us = 0.01;   // light pulse width
+  double jitter_ns = 0.0;         // simulated backend: timing jitter (1 sigma)
+  std::vector<TriggerChannel> channels;
+};
+
+struct GridConfig {
+  int nx = 512, ny = 512, nz = 160;
+  double voxel_size_mm = 0.0195;
+  double origin_mm[3] = {0.0, 0.0, 0.0};  // world position of the grid centre
+};
+
+struct ProcessingConfig {
+  std::string algorithm = "fmart";  // reconstruction algorithm for the back-end
+  int iterations = 5;
+};
+
+struct SimulationConfig {
+  std::string case_name = "tpiv-thesis";
+  double ppp = 0.05;
+  std::uint64_t seed = 1;
+  int sets = 2;
+  int bit_depth = 16;             // 12 or 16
+  bool noise = false;             // shot + read noise
+  double read_noise_e = 5.0;      // electrons, 1 sigma
+  double peak_counts = 1000.0;    // peak intensity of a particle image
+  std::string light_sheet = "uniform";  // "uniform" | "gaussian" | "tophat"
+};
+
+struct RigConfig {
+  std::string name = "tomorig rig";
+  std::vector<CameraConfig> cameras;
+  TriggerConfig trigger;
+  std::optional<std::filesystem::path> calibration_file;
+  GridConfig grid;
+  ProcessingConfig processing;
+  std::optional<SimulationConfig> simulation;
+  std::string source_text;  // the TOML text it was parsed from
+};
+
+// One problem found while validating: key path ("cameras[2].pixel_format"), line (0 if
+// unknown) and the message saying what is allowed.
+struct ConfigIssue {
+  std::string key;
+  int line = 0;
+  std::string message;
+  std::string to_string() const;  // "rig.toml:12: cameras[2].pixel_format: ..."
+};
+
+// Parses and validates. On any problem throws tomorig::Error (bad_input) whose message lists
+// every issue, one per line. `origin` names the file in messages.
+RigConfig parse_rig_config(const std::string& toml_text, const std::string& origin = "<config>");
+RigConfig load_rig_config(const std::filesystem::path& path);
+// Same checks, returning the issues instead of throwing (empty: valid).
+std::vector<ConfigIssue> check_rig_config(const std::string& toml_text, const std::string& origin = "<config>");
+
+// The embedded default: the simulated 4-camera tpiv-thesis rig.
+const std::string& default_rig_toml();
+RigConfig default_rig_config();
+
+std::string_view to_string(CameraBackend b);
+std::string_view to_string(TriggerBackend b);
+
+}  // namespace tomorig::config

@@ -1,0 +1,121 @@
+#pragma once
+// HDF5 session files: everything needed to reprocess a run (frames, timestamps, trigger
+// events, rig config, truth for simulated sessions). Layout: docs/file-formats.md.
+//
+// Writing goes to "<path>.partial" and is renamed to <path> by finish(), so an interrupted
+// or failed write never leaves a half-written file under the final name.
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tomorig/core/frame_set.h"
+#include "tomorig/core/geometry.h"
+#include "tomorig/core/pixel_format.h"
+
+namespace tomorig::storage {
+
+enum class Compression : std::uint8_t {
+  none,            // raw chunks
+  bitshuffle_lz4,  // HDF5 filter 32008 (Debian package "bitshuffle")
+};
+std::string_view to_string(Compression c);
+std::optional<Compression> parse_compression(std::string_view name);
+
+struct SessionCamera {
+  std::string id;
+  int width = 0;
+  int height = 0;
+  PixelFormat pixel_format = PixelFormat::Mono16;
+  double pixel_pitch_um = 0.0;
+};
+
+// Pinhole parameters of a simulated camera, as recorded in /truth/cameras.
+struct TruthCamera {
+  std::string id;
+  std::string model = "pinhole";
+  Mat3d K{};       // intrinsics, pixels
+  Mat3d R{};       // world -> camera rotation
+  Vec3d t;         // world -> camera translation, mm
+  int width = 0, height = 0;
+};
+
+// Ground truth of a simulated session, one entry per set.
+struct TruthSet {
+  std::vector<Vec3d> particles_a;  // world mm, exposure A
+  std::vector<Vec3d> particles_b;  // world mm, exposure B
+};
+
+struct SessionTruth {
+  std::string case_name;          // e.g. "tpiv-thesis"
+  std::string flow_name;          // e.g. "taylor-green"
+  std::string flow_parameters;    // JSON object text, e.g. {"A_voxel":5,"p_voxel":256}
+  std::uint64_t seed = 0;
+  double ppp = 0.0;
+  std::vector<TruthCamera> cameras;
+};
+
+struct SessionInfo {
+  std::vector<SessionCamera> cameras;
+  std::string rig_config_toml;    // the rig config the session was taken with
+  std::string software_version;
+  std::string created_utc;        // ISO 8601
+  Compression compression = Compression::none;
+};
+
+struct SessionWriterOptions {
+  Compression compression = Compression::none;
+  bool overwrite = false;  // replace an existing file at the final path
+};
+
+class SessionWriter {
+ public:
+  // Creates "<path>.partial". Throws tomorig::Error (bad_input) if the folder is not
+  // writable or the file exists and overwrite is false.
+  SessionWriter(const std::filesystem::path& path, const SessionInfo& info,
+                const SessionWriterOptions& options = {});
+  ~SessionWriter();  // without finish(): closes and removes the partial file
+  SessionWriter(const SessionWriter&) = delete;
+  SessionWriter& operator=(const SessionWriter&) = delete;
+
+  // Appends one set. Frames must match the camera sizes and formats; a missing frame
+  // (empty image) is recorded as missing, not as zeros.
+  void append(const FrameSet& set);
+  void write_truth(const SessionTruth& truth);
+  void write_truth_set(std::uint64_t set_index, const TruthSet& truth);
+  // Flushes, closes and renames the partial file to the final path.
+  void finish();
+
+  std::uint64_t sets_written() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+class SessionReader {
+ public:
+  // Opens and validates the layout. Throws tomorig::Error (bad_input) naming the file and
+  // what is wrong: missing, not HDF5, not a tomorig session, wrong sizes, truncated datasets.
+  explicit SessionReader(const std::filesystem::path& path);
+  ~SessionReader();
+  SessionReader(const SessionReader&) = delete;
+  SessionReader& operator=(const SessionReader&) = delete;
+
+  const SessionInfo& info() const;
+  std::uint64_t set_count() const;
+  FrameSet read_set(std::uint64_t set_index) const;
+  int missing_frames() const;     // over the whole session
+  int incomplete_sets() const;
+  bool has_truth() const;
+  SessionTruth truth() const;
+  TruthSet truth_set(std::uint64_t set_index) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace tomorig::storage
