@@ -18,7 +18,7 @@ enum class TriggerBackend : std::uint8_t { gpio, simulated };
 
 struct Roi {
   int offset_x = 0, offset_y = 0;
-  int width = 0, height = 0;  // pixels
+  int width = 0, height = 0;  // pixels; 0 x 0: the full sensor (Aravis camera without [cameras.roi])
 };
 
 struct CameraConfig {
@@ -91,6 +91,8 @@ struct ConfigIssue {
   std::string key;
   int line = 0;
   std::string message;
+  std::string origin;  // the file (or "<config>"); empty: left out of to_string()
+  int column = 0;      // TOML syntax errors only (0: not shown)
   std::string to_string() const;  // "rig.toml:12: cameras[2].pixel_format: ..."
 };
 
@@ -104,6 +106,9 @@ std::vector<ConfigIssue> check_rig_config(const std::string& toml_text, const st
 // The embedded default: the simulated 4-camera tpiv-thesis rig.
 const std::string& default_rig_toml();
 RigConfig default_rig_config();
+
+// The simulator's built-in cases ([simulation] case), as defined in ../shared/benchmarks.
+const std::vector<std::string>& simulation_case_names();
 
 std::string_view to_string(CameraBackend b);
 std::string_view to_string(TriggerBackend b);

@@ -4,6 +4,7 @@
 //
 // Writing goes to "<path>.partial" and is renamed to <path> by finish(), so an interrupted
 // or failed write never leaves a half-written file under the final name.
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -65,6 +66,18 @@ struct SessionInfo {
   Compression compression = Compression::none;
 };
 
+// The per-set records of a session without the pixels: what /sets holds for one set.
+struct SetRecord {
+  std::uint64_t trigger_index = 0;
+  std::int64_t trigger_timestamp_ns = 0;
+  std::int64_t dt_ns = 0;
+  // One entry per camera, in session order; [0] is exposure A, [1] exposure B.
+  std::vector<std::array<std::int64_t, 2>> frame_timestamp_ns;
+  std::vector<std::array<bool, 2>> frame_present;
+};
+
+// SessionInfo::software_version and created_utc are filled in by the writer when empty;
+// SessionInfo::compression is ignored on writing (the options decide).
 struct SessionWriterOptions {
   Compression compression = Compression::none;
   bool overwrite = false;  // replace an existing file at the final path
@@ -81,14 +94,20 @@ class SessionWriter {
   SessionWriter& operator=(const SessionWriter&) = delete;
 
   // Appends one set. Frames must match the camera sizes and formats; a missing frame
-  // (empty image) is recorded as missing, not as zeros.
+  // (empty image) is recorded as missing, not as zeros. Cameras are matched by id; a session
+  // camera absent from the set counts as two missing frames. set.set_index is ignored: sets
+  // are numbered in the order they are appended. A wrong frame throws bad_input before
+  // anything is written; an HDF5 failure throws runtime and the writer refuses further use.
   void append(const FrameSet& set);
+  // Truth of simulated sessions: write_truth once, write_truth_set once per set index.
   void write_truth(const SessionTruth& truth);
   void write_truth_set(std::uint64_t set_index, const TruthSet& truth);
   // Flushes, closes and renames the partial file to the final path.
   void finish();
 
   std::uint64_t sets_written() const;
+  const std::filesystem::path& path() const;          // the final path
+  const std::filesystem::path& partial_path() const;  // "<path>.partial"
 
  private:
   struct Impl;
@@ -105,13 +124,21 @@ class SessionReader {
   SessionReader& operator=(const SessionReader&) = delete;
 
   const SessionInfo& info() const;
+  const std::filesystem::path& path() const;
+  int format_version() const;
   std::uint64_t set_count() const;
+  // Pixels and records of one set; bad_input if set_index >= set_count(), or if the file turns
+  // out to be corrupt while reading.
   FrameSet read_set(std::uint64_t set_index) const;
+  // The records of one set without reading pixels (cheap: held in memory).
+  SetRecord set_record(std::uint64_t set_index) const;
   int missing_frames() const;     // over the whole session
   int incomplete_sets() const;
   bool has_truth() const;
-  SessionTruth truth() const;
-  TruthSet truth_set(std::uint64_t set_index) const;
+  SessionTruth truth() const;                              // bad_input if !has_truth()
+  bool has_truth_set(std::uint64_t set_index) const;
+  std::uint64_t truth_set_count() const;                   // sets with /truth/sets/<index>
+  TruthSet truth_set(std::uint64_t set_index) const;       // bad_input if absent
 
  private:
   struct Impl;

@@ -1,0 +1,24 @@
+#pragma once
+// Decoding a parsed TOML document into a RigConfig, one section per file. Each decoder reads
+// its keys through a TableReader (which records type, range and unknown-key issues) and adds
+// the cross-key checks of its section. Values that fail keep their defaults; the caller
+// throws if any issue was recorded, so a half-valid RigConfig never escapes.
+#include <optional>
+#include <vector>
+
+#include <toml++/toml.h>
+
+#include "tomorig/config/rig_config.h"
+#include "toml_reader.h"
+
+namespace tomorig::config::detail {
+
+RigConfig decode_rig(const toml::table& root, std::vector<ConfigIssue>& issues);
+
+void decode_cameras(TableReader& root, std::vector<CameraConfig>& cameras);      // [[cameras]]
+void decode_trigger(TableReader& root, TriggerConfig& trigger);                  // [trigger]
+void decode_grid(TableReader& root, GridConfig& grid);                           // [grid]
+void decode_processing(TableReader& root, ProcessingConfig& processing);         // [processing]
+void decode_simulation(TableReader& root, std::optional<SimulationConfig>& sim);  // [simulation]
+
+}  // namespace tomorig::config::detail

@@ -1,0 +1,23 @@
+#include "decode.h"
+
+namespace tomorig::config::detail {
+
+RigConfig decode_rig(const toml::table& root_table, std::vector<ConfigIssue>& issues) {
+  RigConfig rig;
+  TableReader root(root_table, "", issues);
+  root.read("name", rig.name);
+  decode_cameras(root, rig.cameras);
+  decode_trigger(root, rig.trigger);
+  if (auto calibration = root.table("calibration")) {
+    std::string file;
+    if (calibration->read("file", file, Need::required, not_empty())) rig.calibration_file = file;
+    calibration->report_unknown_keys();
+  }
+  decode_grid(root, rig.grid);
+  decode_processing(root, rig.processing);
+  decode_simulation(root, rig.simulation);
+  root.report_unknown_keys();
+  return rig;
+}
+
+}  // namespace tomorig::config::detail

@@ -1,0 +1,116 @@
+#include "tomorig/simulators/simulated_rig.h"
+
+#include <cmath>
+
+#include <fmt/core.h>
+
+#include "tomorig/core/error.h"
+#include "tomorig/simulators/random.h"
+#include "tomorig/simulators/scene.h"
+
+namespace tomorig::sim {
+namespace {
+
+int bit_depth_of(const SimulatedCameraSpec& spec) {
+  switch (spec.pixel_format) {
+    case PixelFormat::Mono12: return 12;
+    case PixelFormat::Mono16: return 16;
+    default: break;
+  }
+  throw bad_input(fmt::format("simulated camera '{}': pixel format {} is not supported: use Mono12 or Mono16",
+                              spec.id, to_string(spec.pixel_format)));
+}
+
+}  // namespace
+
+void SimulationOptions::validate() const {
+  // Written as !(a < x) so that NaN fails too.
+  if (!(ppp > 0.0 && ppp <= 1.0))
+    throw bad_input(fmt::format("simulation: ppp = {} is out of range: particle images per pixel must be in (0, 1]", ppp));
+  if (!(peak_counts > 0) || !std::isfinite(peak_counts))
+    throw bad_input(fmt::format("simulation: peak_counts = {} must be > 0", peak_counts));
+  if (!(read_noise_e >= 0) || !std::isfinite(read_noise_e))
+    throw bad_input(fmt::format("simulation: read_noise_e = {} must be >= 0", read_noise_e));
+  if (!(gain_counts_per_e > 0) || !std::isfinite(gain_counts_per_e))
+    throw bad_input(fmt::format("simulation: gain_counts_per_e = {} must be > 0", gain_counts_per_e));
+  if (!(rate_hz > 0) || !std::isfinite(rate_hz))
+    throw bad_input(fmt::format("simulation: rate_hz = {} must be > 0", rate_hz));
+  if (dt_ns < 0) throw bad_input(fmt::format("simulation: dt_ns = {} must be >= 0", dt_ns));
+  if (threads < 0) throw bad_input(fmt::format("simulation: threads = {} must be >= 0", threads));
+  for (std::size_t i = 0; i < cameras.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (cameras[i].id == cameras[j].id)
+        throw bad_input(fmt::format("simulation: camera id '{}' is used twice", cameras[i].id));
+}
+
+std::size_t particle_count(double ppp, const std::vector<SimulatedCameraSpec>& cameras) {
+  if (cameras.empty()) return 0;
+  double pixels = 0;
+  for (const auto& c : cameras) pixels += static_cast<double>(c.width) * c.height;
+  return static_cast<std::size_t>(std::llround(ppp * pixels / static_cast<double>(cameras.size())));
+}
+
+SimulatedRig::SimulatedRig(const SimulationOptions& options)
+    : options_(options), case_(&find_case(options.case_name)) {
+  options_.validate();
+  const std::vector<SimulatedCameraSpec>& specs = options_.cameras.empty() ? case_->cameras : options_.cameras;
+  if (specs.empty()) throw bad_input("simulation: the rig has no cameras to render");
+  for (const SimulatedCameraSpec& spec : specs) {
+    bit_depth_of(spec);  // refuses unsupported formats before any rendering
+    cameras_.push_back({spec, calibration::PinholeCamera::yawed(spec.yaw_deg, spec.focal_length_mm, spec.pixel_pitch_um,
+                                                                spec.distance_mm, spec.width, spec.height)});
+  }
+  flow_ = case_->make_flow(*case_);
+  sheet_ = LightSheet::for_slab(options_.light_sheet, case_->slab);
+  image_options_.sigma_px = case_->sigma_px;
+  image_options_.peak_counts = options_.peak_counts;
+  image_options_.threads = options_.threads;
+  image_options_.validate();
+  particles_per_set_ = particle_count(options_.ppp, specs);
+}
+
+std::vector<Vec3d> SimulatedRig::particle_midpoints(std::uint64_t set_index) const {
+  return uniform_particles(case_->slab, particles_per_set_, derive_seed(options_.seed, {kParticleStream, set_index}));
+}
+
+Image SimulatedRig::render_signal(std::size_t camera, std::span<const Vec3d> particles) const {
+  const SimulatedCamera& cam = cameras_.at(camera);
+  Image signal = Image::allocate(cam.spec.width, cam.spec.height, SampleType::f32);
+  render_particles(cam.model, particles, sheet_, image_options_, signal);
+  return signal;
+}
+
+SimulatedSet SimulatedRig::render_set(std::uint64_t set_index) const {
+  SimulatedSet out;
+  ParticlePair pair = straddle(particle_midpoints(set_index), *flow_);
+
+  FrameSet& frames = out.frames;
+  frames.set_index = set_index;
+  frames.trigger_index = set_index;
+  frames.trigger_timestamp_ns = std::llround(static_cast<double>(set_index) * 1e9 / options_.rate_hz);
+  frames.dt_ns = options_.dt_ns;
+  frames.cameras.resize(cameras_.size());
+  for (std::size_t c = 0; c < cameras_.size(); ++c) {
+    SensorOptions sensor;
+    sensor.bit_depth = bit_depth_of(cameras_[c].spec);
+    sensor.noise = options_.noise;
+    sensor.read_noise_e = options_.read_noise_e;
+    sensor.gain_counts_per_e = options_.gain_counts_per_e;
+    sensor.threads = options_.threads;
+    CameraFrames& cf = frames.cameras[c];
+    cf.camera_id = cameras_[c].spec.id;
+    for (Exposure e : {Exposure::A, Exposure::B}) {
+      const std::vector<Vec3d>& particles = e == Exposure::A ? pair.a : pair.b;
+      const Image signal = render_signal(c, particles);
+      const std::uint64_t noise_seed =
+          derive_seed(options_.seed, {kNoiseStream, set_index, c, static_cast<std::uint64_t>(e)});
+      cf[e].image = digitise(signal, sensor, noise_seed);
+      cf[e].timestamp_ns = frames.trigger_timestamp_ns + (e == Exposure::A ? 0 : options_.dt_ns);
+    }
+  }
+  out.particles_a = std::move(pair.a);
+  out.particles_b = std::move(pair.b);
+  return out;
+}
+
+}  // namespace tomorig::sim

@@ -1,0 +1,19 @@
+#pragma once
+// Reading single-channel 8- and 16-bit images written by other tools (TIFF, including
+// multi-page TIFF, PNG, and whatever else OpenCV reads), for imports and calibration
+// targets. OpenCV stays inside storage/src.
+#include <filesystem>
+
+#include "tomorig/core/image.h"
+
+namespace tomorig::storage {
+
+// Number of pages (1 for single-page formats). Throws bad_input naming the file if it does
+// not exist or is not an image OpenCV can read.
+int image_page_count(const std::filesystem::path& file);
+
+// One page as an owning Image of uint8 or uint16 samples, bit for bit as stored. Throws
+// bad_input naming the file (and page) if it cannot be read or is not single-channel 8/16-bit.
+Image read_image(const std::filesystem::path& file, int page = 0);
+
+}  // namespace tomorig::storage

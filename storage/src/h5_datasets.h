@@ -1,0 +1,72 @@
+#pragma once
+// Dataset and group helpers. `where` names the object in error messages; failures throw
+// h5::Failure.
+#include <hdf5.h>
+
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "h5_handle.h"
+
+namespace tomorig::storage::h5 {
+
+bool link_exists(hid_t location, const char* name);
+Group create_group(hid_t location, const char* name, std::string_view where);
+// Throws Failure("<where> is missing") if there is no such group.
+Group open_group(hid_t location, const char* name, std::string_view where);
+Dataset open_dataset(hid_t location, const char* name, std::string_view where);
+
+std::vector<hsize_t> dims_of(hid_t dataset, std::string_view where);
+
+// Reads or writes the block [offset, offset + count) of a dataset from or to a contiguous
+// memory buffer of `mem_type`.
+void read_block(hid_t dataset, std::span<const hsize_t> offset, std::span<const hsize_t> count, hid_t mem_type,
+                void* out, std::string_view where);
+void write_block(hid_t dataset, std::span<const hsize_t> offset, std::span<const hsize_t> count, hid_t mem_type,
+                 const void* data, std::string_view where);
+// Reads a whole dataset, converted to `mem_type`, into `out` (which must be large enough).
+void read_all(hid_t dataset, hid_t mem_type, void* out, std::string_view where);
+
+// A fixed-size dataset of `file_type` with shape `dims`, written in one go (contiguous layout).
+void write_dataset(hid_t location, const char* name, hid_t file_type, std::span<const hsize_t> dims,
+                   hid_t mem_type, const void* data, std::string_view where);
+
+// A scalar variable-length UTF-8 string dataset (e.g. /config).
+void write_string_dataset(hid_t location, const char* name, std::string_view text, std::string_view where);
+std::string read_string_dataset(hid_t location, const char* name, std::string_view where);
+
+// A chunked dataset whose first dimension starts at 0 and grows without limit, one set at a
+// time. It stays open for the life of the writer: reopening per frame costs more than the
+// write itself for small frames.
+class GrowingDataset {
+ public:
+  struct Options {
+    hid_t file_type = H5T_STD_U8LE;
+    std::vector<hsize_t> record_shape;  // dimensions after the first
+    std::vector<hsize_t> chunk;         // full chunk shape, first dimension included
+    hid_t dcpl = H5P_DEFAULT;           // filters; the chunk shape is added to a copy
+    bool chunk_cache = true;            // false: write chunks straight through, no caching
+  };
+
+  GrowingDataset() = default;
+  GrowingDataset(hid_t location, const char* name, std::string where, const Options& options);
+
+  // Extends the first dimension to `records`.
+  void grow_to(hsize_t records);
+  void write(std::span<const hsize_t> offset, std::span<const hsize_t> count, hid_t mem_type, const void* data);
+  // Writes one full record (all dimensions after the first) at `record`.
+  void write_record(hsize_t record, hid_t mem_type, const void* data);
+  herr_t close() { return dataset_.close(); }
+  const std::string& where() const { return where_; }
+
+ private:
+  Dataset dataset_;
+  std::string where_;
+  std::vector<hsize_t> dims_;    // current extent
+  std::vector<hsize_t> offset_;  // scratch for write_record
+  std::vector<hsize_t> count_;   // one record
+};
+
+}  // namespace tomorig::storage::h5

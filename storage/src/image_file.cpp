@@ -1,0 +1,78 @@
+#include "tomorig/storage/image_file.h"
+
+#include <memory>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include <fmt/format.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "tomorig/core/error.h"
+
+namespace tomorig::storage {
+namespace fs = std::filesystem;
+namespace {
+
+void require_file(const fs::path& file) {
+  std::error_code ec;
+  if (!fs::exists(file, ec)) throw bad_input(fmt::format("image file '{}' does not exist", file.string()));
+  if (fs::is_directory(file, ec)) throw bad_input(fmt::format("'{}' is a folder, not an image file", file.string()));
+}
+
+std::string describe(const fs::path& file, int page) {
+  return page > 0 ? fmt::format("'{}' (page {})", file.string(), page + 1) : fmt::format("'{}'", file.string());
+}
+
+// Wraps the decoded matrix without copying: the Image's lease keeps the cv::Mat alive.
+Image to_image(cv::Mat mat, const fs::path& file, int page) {
+  SampleType type;
+  if (mat.type() == CV_8UC1) {
+    type = SampleType::u8;
+  } else if (mat.type() == CV_16UC1) {
+    type = SampleType::u16;
+  } else {
+    throw bad_input(fmt::format("{} has {} channel(s) of {}-bit {} samples; tomorig imports single-channel 8- or "
+                                "16-bit unsigned images",
+                                describe(file, page), mat.channels(), 8 * mat.elemSize1(),
+                                mat.depth() == CV_32F || mat.depth() == CV_64F ? "floating-point" : "integer"));
+  }
+  auto holder = std::make_shared<cv::Mat>(std::move(mat));
+  return Image::view(holder->data, holder->cols, holder->rows, type, holder->step[0], holder);
+}
+
+}  // namespace
+
+int image_page_count(const fs::path& file) {
+  require_file(file);
+  std::size_t pages = 0;
+  try {
+    pages = cv::imcount(file.string(), cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& e) {
+    throw bad_input(fmt::format("cannot read image file '{}': {}", file.string(), e.what()));
+  }
+  if (pages == 0)
+    throw bad_input(fmt::format("cannot read '{}' as an image (unknown format or damaged file)", file.string()));
+  return static_cast<int>(pages);
+}
+
+Image read_image(const fs::path& file, int page) {
+  require_file(file);
+  try {
+    if (page == 0) {
+      cv::Mat mat = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
+      if (mat.empty())
+        throw bad_input(fmt::format("cannot read '{}' as an image (unknown format or damaged file)", file.string()));
+      return to_image(std::move(mat), file, 0);
+    }
+    std::vector<cv::Mat> mats;
+    if (!cv::imreadmulti(file.string(), mats, page, 1, cv::IMREAD_UNCHANGED) || mats.empty() || mats[0].empty())
+      throw bad_input(fmt::format("cannot read page {} of '{}'", page + 1, file.string()));
+    return to_image(std::move(mats[0]), file, page);
+  } catch (const cv::Exception& e) {
+    throw bad_input(fmt::format("cannot read image file '{}': {}", file.string(), e.what()));
+  }
+}
+
+}  // namespace tomorig::storage

@@ -1,0 +1,433 @@
+// SessionReader: opens a session file, validates its layout up front (so a bad file fails
+// at open with one clear message instead of half-way through processing) and reads sets.
+#include <algorithm>
+#include <array>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "compression.h"
+#include "h5_attributes.h"
+#include "h5_datasets.h"
+#include "h5_error.h"
+#include "h5_handle.h"
+#include "session_layout.h"
+#include "tomorig/core/error.h"
+#include "tomorig/storage/session_file.h"
+
+namespace tomorig::storage {
+namespace fs = std::filesystem;
+namespace {
+
+struct CameraDataset {
+  h5::Dataset frames;
+  std::string where;
+  hid_t mem_type = H5T_NATIVE_UINT8;
+  SampleType sample_type = SampleType::u8;
+  std::array<hsize_t, 4> count{};  // one frame
+};
+
+// An image whose buffer is not zero-filled first: HDF5 overwrites every byte.
+Image uninitialised_image(int width, int height, SampleType type) {
+  const std::size_t bytes = static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * bytes_per_sample(type);
+  std::shared_ptr<std::byte[]> buffer = std::make_shared_for_overwrite<std::byte[]>(bytes);
+  std::byte* data = buffer.get();
+  return Image::view(data, width, height, type, 0, std::move(buffer));
+}
+
+// Integer dataset types the frames may use, by pixel format.
+void check_frame_type(hid_t dataset, const SessionCamera& camera, const std::string& where) {
+  h5::Datatype type(h5::check(H5Dget_type(dataset), "cannot read the type of", where));
+  const bool is_int = H5Tget_class(type.get()) == H5T_INTEGER;
+  const std::size_t bits = 8 * H5Tget_size(type.get());
+  const std::size_t wanted = 8 * bytes_per_sample(sample_type_of(camera.pixel_format));
+  if (!is_int || bits != wanted || H5Tget_sign(type.get()) != H5T_SGN_NONE)
+    throw h5::Failure(fmt::format("camera {}: frames are stored as {}, but pixel format {} needs unsigned {}-bit "
+                                  "integers",
+                                  camera.id, is_int ? fmt::format("{}-bit integers", bits) : "non-integers",
+                                  to_string(camera.pixel_format), wanted));
+}
+
+}  // namespace
+
+struct SessionReader::Impl {
+  explicit Impl(const fs::path& path);
+
+  // Everything wrong with the file's content is reported as bad input naming the file.
+  [[noreturn]] void corrupt(const std::string& what) const {
+    throw bad_input(fmt::format("session file '{}' is corrupt or truncated: {}", path.string(), what));
+  }
+  [[noreturn]] void invalid(const std::string& what) const {
+    throw bad_input(fmt::format("session file '{}' is not a valid tomorig session: {}", path.string(), what));
+  }
+
+  void open_file();
+  void read_root();
+  void read_cameras();
+  void check_filters(hid_t dataset, const std::string& where) const;
+  void read_sets();
+  template <typename T>
+  std::vector<T> read_set_dataset(hid_t group, const char* name, hid_t mem_type, std::vector<hsize_t> record_shape);
+  void check_index(std::uint64_t set_index) const;
+  h5::Group truth_sets_group() const;
+
+  fs::path path;
+  h5::File file;
+  SessionInfo info;
+  int format_version = 0;
+  std::vector<CameraDataset> cameras;
+  std::uint64_t sets = 0;
+  std::vector<std::uint64_t> trigger_index;
+  std::vector<std::int64_t> trigger_timestamp, dt;
+  std::vector<std::int64_t> frame_timestamp;  // [set][camera][exposure]
+  std::vector<std::uint8_t> frame_present;    // [set][camera][exposure]
+  int missing = 0;
+  int incomplete = 0;
+  bool truth = false;
+};
+
+SessionReader::Impl::Impl(const fs::path& p) : path(p) {
+  open_file();
+  try {
+    read_root();
+    read_cameras();
+    read_sets();
+    truth = h5::link_exists(file.get(), layout::kTruth);
+  } catch (const h5::Failure& failure) {
+    corrupt(failure.what());
+  }
+}
+
+void SessionReader::Impl::open_file() {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw bad_input(fmt::format("session file '{}' does not exist", path.string()));
+  if (fs::is_directory(path, ec))
+    throw bad_input(fmt::format("'{}' is a folder, not a session file", path.string()));
+  const htri_t is_hdf5 = H5Fis_hdf5(path.c_str());
+  if (is_hdf5 <= 0)
+    throw bad_input(fmt::format("'{}' is not an HDF5 file, so not a tomorig session{}", path.string(),
+                                is_hdf5 < 0 ? fmt::format(" ({})", h5::error_stack_text()) : ""));
+  const hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (id < 0) {
+    const std::string reason = h5::error_stack_text();
+    // HDF5 1.10 locks files; a writer that has the file open holds the lock.
+    if (reason.find("lock") != std::string::npos)
+      throw bad_input(fmt::format("session file '{}' is locked by another program (is it still being written?): {}",
+                                  path.string(), reason));
+    corrupt(fmt::format("HDF5 cannot open it: {}", reason));
+  }
+  file = h5::File(id);
+}
+
+void SessionReader::Impl::read_root() {
+  const hid_t root = file.get();
+  if (!h5::has_attr(root, layout::kAttrFormat))
+    invalid(fmt::format("it is an HDF5 file without the root attribute '{}' = '{}'", layout::kAttrFormat,
+                        layout::kFormatName));
+  const std::string format = h5::read_string_attr(root, layout::kAttrFormat, "/");
+  if (format != layout::kFormatName)
+    invalid(fmt::format("its root attribute '{}' is '{}', expected '{}'", layout::kAttrFormat, format,
+                        layout::kFormatName));
+  if (!h5::has_attr(root, layout::kAttrFormatVersion))
+    invalid(fmt::format("the root attribute '{}' is missing", layout::kAttrFormatVersion));
+  const std::int64_t version = h5::read_int_attr(root, layout::kAttrFormatVersion, "/");
+  if (version < 1 || version > layout::kFormatVersion)
+    throw bad_input(fmt::format("session file '{}' has format version {}, but this tomorig reads versions 1 to {}{}",
+                                path.string(), version, layout::kFormatVersion,
+                                version > layout::kFormatVersion ? ": update tomorig to read it" : ""));
+  format_version = static_cast<int>(version);
+
+  // Descriptive metadata: tolerated when absent, so that files assembled by hand stay readable.
+  if (h5::has_attr(root, layout::kAttrSoftwareVersion))
+    info.software_version = h5::read_string_attr(root, layout::kAttrSoftwareVersion, "/");
+  if (h5::has_attr(root, layout::kAttrCreatedUtc))
+    info.created_utc = h5::read_string_attr(root, layout::kAttrCreatedUtc, "/");
+  if (h5::has_attr(root, layout::kAttrCompression)) {
+    const std::string name = h5::read_string_attr(root, layout::kAttrCompression, "/");
+    const auto compression = parse_compression(name);
+    if (!compression) invalid(fmt::format("unknown compression '{}' (known: none, bitshuffle-lz4)", name));
+    info.compression = *compression;
+  }
+  if (h5::link_exists(root, layout::kConfig))
+    info.rig_config_toml = h5::read_string_dataset(root, layout::kConfig, "/config");
+}
+
+void SessionReader::Impl::read_cameras() {
+  if (!h5::link_exists(file.get(), layout::kCameras)) invalid("the group /cameras is missing");
+  h5::Group group = h5::open_group(file.get(), layout::kCameras, "/cameras");
+  const std::vector<std::string> order = h5::read_string_list_attr(group.get(), layout::kAttrOrder, "/cameras");
+  if (order.empty()) invalid("/cameras lists no cameras");
+
+  for (const std::string& id : order) {
+    const std::string where = layout::camera_path(id);
+    if (id.empty() || !h5::link_exists(group.get(), id.c_str()))
+      invalid(fmt::format("camera '{}' is listed in /cameras 'order' but {} is missing", id, where));
+    h5::Group cam = h5::open_group(group.get(), id.c_str(), where);
+    SessionCamera camera;
+    camera.id = id;
+    camera.width = static_cast<int>(h5::read_int_attr(cam.get(), layout::kAttrWidth, where));
+    camera.height = static_cast<int>(h5::read_int_attr(cam.get(), layout::kAttrHeight, where));
+    if (camera.width <= 0 || camera.height <= 0)
+      invalid(fmt::format("camera {} has size {} x {}", id, camera.width, camera.height));
+    const std::string format = h5::read_string_attr(cam.get(), layout::kAttrPixelFormat, where);
+    const auto pixel_format = parse_pixel_format(format);
+    if (!pixel_format)
+      invalid(fmt::format("camera {} has pixel format '{}'; known formats: {}", id, format, supported_pixel_formats()));
+    camera.pixel_format = *pixel_format;
+    if (h5::has_attr(cam.get(), layout::kAttrPixelPitch))
+      camera.pixel_pitch_um = h5::read_double_attr(cam.get(), layout::kAttrPixelPitch, where);
+
+    CameraDataset ds;
+    ds.where = layout::frames_path(id);
+    ds.frames = h5::open_dataset(cam.get(), layout::kFrames, ds.where);
+    const std::vector<hsize_t> dims = h5::dims_of(ds.frames.get(), ds.where);
+    if (dims.size() != 4 || dims[1] != 2)
+      invalid(fmt::format("{} should have shape [sets, 2, height, width] but has {} dimensions{}", ds.where,
+                          dims.size(), dims.size() == 4 ? fmt::format(" with {} exposures", dims[1]) : ""));
+    if (dims[2] != static_cast<hsize_t>(camera.height) || dims[3] != static_cast<hsize_t>(camera.width))
+      invalid(fmt::format("camera {}: frames are {} x {} but the session says {} x {}", id, dims[3], dims[2],
+                          camera.width, camera.height));
+    check_frame_type(ds.frames.get(), camera, ds.where);
+    check_filters(ds.frames.get(), ds.where);
+    if (cameras.empty()) {
+      sets = dims[0];
+    } else if (dims[0] != sets) {
+      corrupt(fmt::format("camera {} holds {} sets but camera {} holds {}", id, dims[0], info.cameras.front().id,
+                          sets));
+    }
+    ds.sample_type = sample_type_of(camera.pixel_format);
+    ds.mem_type = layout::memory_sample_type(ds.sample_type);
+    ds.count = {1, 1, dims[2], dims[3]};
+    cameras.push_back(std::move(ds));
+    info.cameras.push_back(camera);
+  }
+}
+
+// A compressed session needs its filter plugin to read; say so now rather than fail on the
+// first frame with HDF5's "can't open directory or file" from deep inside the plugin loader.
+void SessionReader::Impl::check_filters(hid_t dataset, const std::string& where) const {
+  h5::PropertyList dcpl(h5::check(H5Dget_create_plist(dataset), "cannot read the creation properties of", where));
+  const int n = h5::check(H5Pget_nfilters(dcpl.get()), "cannot read the filters of", where);
+  for (int i = 0; i < n; ++i) {
+    unsigned flags = 0;
+    std::size_t n_values = 0;
+    unsigned config = 0;
+    const H5Z_filter_t filter = H5Pget_filter2(dcpl.get(), static_cast<unsigned>(i), &flags, &n_values, nullptr, 0,
+                                               nullptr, &config);
+    if (filter < 0) h5::fail("cannot read the filters of", where);
+    require_filter(filter, fmt::format("reading session '{}'", path.string()));
+  }
+}
+
+template <typename T>
+std::vector<T> SessionReader::Impl::read_set_dataset(hid_t group, const char* name, hid_t mem_type,
+                                                     std::vector<hsize_t> record_shape) {
+  const std::string where = layout::sets_path(name);
+  if (!h5::link_exists(group, name)) invalid(fmt::format("{} is missing", where));
+  h5::Dataset dataset = h5::open_dataset(group, name, where);
+  const std::vector<hsize_t> dims = h5::dims_of(dataset.get(), where);
+  std::vector<hsize_t> expected{sets};
+  expected.insert(expected.end(), record_shape.begin(), record_shape.end());
+  if (dims.size() != expected.size() || !std::equal(dims.begin() + 1, dims.end(), expected.begin() + 1))
+    invalid(fmt::format("{} has shape [{}] but should be [{}]", where, fmt::join(dims, ", "), fmt::join(expected, ", ")));
+  if (dims[0] != sets)
+    corrupt(fmt::format("{} holds {} sets but the camera frames hold {}", where, dims[0], sets));
+  std::size_t n = 1;
+  for (hsize_t d : expected) n *= d;
+  std::vector<T> values(n);
+  if (n > 0) h5::read_all(dataset.get(), mem_type, values.data(), where);
+  return values;
+}
+
+void SessionReader::Impl::read_sets() {
+  if (!h5::link_exists(file.get(), layout::kSets)) invalid("the group /sets is missing");
+  h5::Group group = h5::open_group(file.get(), layout::kSets, "/sets");
+  const hsize_t n_cams = cameras.size();
+  trigger_index = read_set_dataset<std::uint64_t>(group.get(), layout::kTriggerIndex, H5T_NATIVE_UINT64, {});
+  trigger_timestamp = read_set_dataset<std::int64_t>(group.get(), layout::kTriggerTimestamp, H5T_NATIVE_INT64, {});
+  dt = read_set_dataset<std::int64_t>(group.get(), layout::kDt, H5T_NATIVE_INT64, {});
+  frame_timestamp = read_set_dataset<std::int64_t>(group.get(), layout::kFrameTimestamp, H5T_NATIVE_INT64, {n_cams, 2});
+  frame_present = read_set_dataset<std::uint8_t>(group.get(), layout::kFramePresent, H5T_NATIVE_UINT8, {n_cams, 2});
+
+  const std::size_t per_set = 2 * cameras.size();
+  for (std::uint64_t s = 0; s < sets; ++s) {
+    const auto first = frame_present.begin() + static_cast<std::ptrdiff_t>(s * per_set);
+    const auto lost = std::count(first, first + static_cast<std::ptrdiff_t>(per_set), std::uint8_t{0});
+    missing += static_cast<int>(lost);
+    incomplete += lost > 0 ? 1 : 0;
+  }
+}
+
+void SessionReader::Impl::check_index(std::uint64_t set_index) const {
+  if (set_index >= sets)
+    throw bad_input(sets == 0 ? fmt::format("set {} does not exist: session '{}' holds no sets", set_index,
+                                            path.string())
+                              : fmt::format("set {} does not exist: session '{}' holds sets 0 to {}", set_index,
+                                            path.string(), sets - 1));
+}
+
+h5::Group SessionReader::Impl::truth_sets_group() const {
+  if (!truth) throw bad_input(fmt::format("session '{}' holds no truth (only simulated sessions do)", path.string()));
+  h5::Group t = h5::open_group(file.get(), layout::kTruth, "/truth");
+  if (!h5::link_exists(t.get(), layout::kSets)) return {};
+  return h5::open_group(t.get(), layout::kSets, "/truth/sets");
+}
+
+SessionReader::SessionReader(const fs::path& path) {
+  h5::silence_errors();
+  impl_ = std::make_unique<Impl>(path);
+}
+
+SessionReader::~SessionReader() = default;
+
+const SessionInfo& SessionReader::info() const { return impl_->info; }
+const fs::path& SessionReader::path() const { return impl_->path; }
+int SessionReader::format_version() const { return impl_->format_version; }
+std::uint64_t SessionReader::set_count() const { return impl_->sets; }
+int SessionReader::missing_frames() const { return impl_->missing; }
+int SessionReader::incomplete_sets() const { return impl_->incomplete; }
+bool SessionReader::has_truth() const { return impl_->truth; }
+
+SetRecord SessionReader::set_record(std::uint64_t set_index) const {
+  const Impl& m = *impl_;
+  m.check_index(set_index);
+  SetRecord r;
+  r.trigger_index = m.trigger_index[set_index];
+  r.trigger_timestamp_ns = m.trigger_timestamp[set_index];
+  r.dt_ns = m.dt[set_index];
+  const std::size_t n = m.cameras.size();
+  r.frame_timestamp_ns.resize(n);
+  r.frame_present.resize(n);
+  for (std::size_t c = 0; c < n; ++c)
+    for (std::size_t e = 0; e < 2; ++e) {
+      const std::size_t k = (set_index * n + c) * 2 + e;
+      r.frame_timestamp_ns[c][e] = m.frame_timestamp[k];
+      r.frame_present[c][e] = m.frame_present[k] != 0;
+    }
+  return r;
+}
+
+FrameSet SessionReader::read_set(std::uint64_t set_index) const {
+  h5::silence_errors();
+  const Impl& m = *impl_;
+  const SetRecord record = set_record(set_index);
+  FrameSet set;
+  set.set_index = set_index;
+  set.trigger_index = record.trigger_index;
+  set.trigger_timestamp_ns = record.trigger_timestamp_ns;
+  set.dt_ns = record.dt_ns;
+  set.cameras.resize(m.cameras.size());
+  for (std::size_t c = 0; c < m.cameras.size(); ++c) {
+    const CameraDataset& ds = m.cameras[c];
+    const SessionCamera& camera = m.info.cameras[c];
+    CameraFrames& frames = set.cameras[c];
+    frames.camera_id = camera.id;
+    for (const Exposure e : {Exposure::A, Exposure::B}) {
+      const auto k = static_cast<std::size_t>(e);
+      Frame& frame = frames[e];
+      frame.timestamp_ns = record.frame_timestamp_ns[c][k];
+      if (!record.frame_present[c][k]) continue;  // lost when recorded: stays empty
+      frame.image = uninitialised_image(camera.width, camera.height, ds.sample_type);
+      const std::array<hsize_t, 4> offset{set_index, k, 0, 0};
+      try {
+        h5::read_block(ds.frames.get(), offset, ds.count, ds.mem_type, frame.image.data(), ds.where);
+      } catch (const h5::Failure& failure) {
+        m.corrupt(fmt::format("frame {} of camera {} in set {}: {}", e == Exposure::A ? 'A' : 'B', camera.id,
+                              set_index, failure.what()));
+      }
+    }
+  }
+  return set;
+}
+
+SessionTruth SessionReader::truth() const {
+  h5::silence_errors();
+  const Impl& m = *impl_;
+  if (!m.truth) throw bad_input(fmt::format("session '{}' holds no truth (only simulated sessions do)", m.path.string()));
+  SessionTruth truth;
+  try {
+    h5::Group group = h5::open_group(m.file.get(), layout::kTruth, "/truth");
+    truth.case_name = h5::read_string_attr(group.get(), layout::kAttrCase, "/truth");
+    truth.flow_name = h5::read_string_attr(group.get(), layout::kAttrFlow, "/truth");
+    truth.flow_parameters = h5::read_string_attr(group.get(), layout::kAttrFlowParameters, "/truth");
+    truth.seed = h5::read_uint64_attr(group.get(), layout::kAttrSeed, "/truth");
+    truth.ppp = h5::read_double_attr(group.get(), layout::kAttrPpp, "/truth");
+    if (!h5::link_exists(group.get(), layout::kCameras)) return truth;
+    h5::Group cameras = h5::open_group(group.get(), layout::kCameras, "/truth/cameras");
+    for (const std::string& id : h5::read_string_list_attr(cameras.get(), layout::kAttrOrder, "/truth/cameras")) {
+      const std::string where = "/truth/cameras/" + id;
+      h5::Group g = h5::open_group(cameras.get(), id.c_str(), where);
+      TruthCamera c;
+      c.id = id;
+      c.model = h5::read_string_attr(g.get(), layout::kAttrModel, where);
+      const auto K = h5::read_doubles_attr(g.get(), layout::kAttrK, 9, where);
+      const auto R = h5::read_doubles_attr(g.get(), layout::kAttrR, 9, where);
+      const auto t = h5::read_doubles_attr(g.get(), layout::kAttrT, 3, where);
+      std::copy(K.begin(), K.end(), c.K.begin());
+      std::copy(R.begin(), R.end(), c.R.begin());
+      c.t = {t[0], t[1], t[2]};
+      c.width = static_cast<int>(h5::read_int_attr(g.get(), layout::kAttrWidth, where));
+      c.height = static_cast<int>(h5::read_int_attr(g.get(), layout::kAttrHeight, where));
+      truth.cameras.push_back(std::move(c));
+    }
+  } catch (const h5::Failure& failure) {
+    m.corrupt(failure.what());
+  }
+  return truth;
+}
+
+bool SessionReader::has_truth_set(std::uint64_t set_index) const {
+  h5::silence_errors();
+  if (!impl_->truth) return false;
+  try {
+    h5::Group sets = impl_->truth_sets_group();
+    return sets.valid() && h5::link_exists(sets.get(), layout::truth_set_name(set_index).c_str());
+  } catch (const h5::Failure& failure) {
+    impl_->corrupt(failure.what());
+  }
+}
+
+std::uint64_t SessionReader::truth_set_count() const {
+  h5::silence_errors();
+  if (!impl_->truth) return 0;
+  try {
+    h5::Group sets = impl_->truth_sets_group();
+    if (!sets.valid()) return 0;
+    H5G_info_t group_info{};
+    h5::check(H5Gget_info(sets.get(), &group_info), "cannot list", "/truth/sets");
+    return group_info.nlinks;
+  } catch (const h5::Failure& failure) {
+    impl_->corrupt(failure.what());
+  }
+}
+
+TruthSet SessionReader::truth_set(std::uint64_t set_index) const {
+  h5::silence_errors();
+  const Impl& m = *impl_;
+  if (!has_truth_set(set_index))
+    throw bad_input(fmt::format("session '{}' holds no truth for set {}", m.path.string(), set_index));
+  TruthSet truth;
+  try {
+    h5::Group sets = m.truth_sets_group();
+    const std::string where = layout::truth_set_path(set_index);
+    h5::Group g = h5::open_group(sets.get(), layout::truth_set_name(set_index).c_str(), where);
+    for (const auto& [name, particles] : {std::pair{layout::kParticlesA, &truth.particles_a},
+                                          std::pair{layout::kParticlesB, &truth.particles_b}}) {
+      const std::string path = where + "/" + name;
+      h5::Dataset ds = h5::open_dataset(g.get(), name, path);
+      const std::vector<hsize_t> dims = h5::dims_of(ds.get(), path);
+      if (dims.size() != 2 || dims[1] != 3)
+        m.invalid(fmt::format("{} should have shape [N, 3] (x, y, z in mm)", path));
+      particles->resize(dims[0]);
+      if (dims[0] > 0) h5::read_all(ds.get(), H5T_NATIVE_DOUBLE, particles->data(), path);
+    }
+  } catch (const h5::Failure& failure) {
+    m.corrupt(failure.what());
+  }
+  return truth;
+}
+
+}  // namespace tomorig::storage

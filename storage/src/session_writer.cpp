@@ -1,0 +1,433 @@
+// SessionWriter: creates the layout of docs/file-formats.md in "<path>.partial", appends
+// sets, and renames the file to <path> on finish().
+#include <array>
+#include <filesystem>
+#include <string>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "compression.h"
+#include "h5_attributes.h"
+#include "h5_datasets.h"
+#include "h5_error.h"
+#include "h5_handle.h"
+#include "partial_file.h"
+#include "session_layout.h"
+#include "tomorig/core/error.h"
+#include "tomorig/core/version.h"
+#include "tomorig/storage/session_file.h"
+#include "utc_time.h"
+
+namespace tomorig::storage {
+namespace fs = std::filesystem;
+namespace {
+
+// An id becomes an HDF5 link name, so it cannot contain '/' or be "." (HDF5's "this group").
+void check_object_name(const std::string& id, const std::string& what, const fs::path& file) {
+  if (id.empty()) throw bad_input(fmt::format("session '{}': {} id is empty", file.string(), what));
+  if (id.find('/') != std::string::npos || id == "." || id == "..")
+    throw bad_input(fmt::format("session '{}': {} id '{}' is not allowed: ids cannot contain '/' or be '.' or '..'",
+                                file.string(), what, id));
+}
+
+void check_cameras(const std::vector<SessionCamera>& cameras, const fs::path& file) {
+  if (cameras.empty()) throw bad_input(fmt::format("session '{}' needs at least one camera", file.string()));
+  std::unordered_set<std::string> seen;
+  for (const auto& c : cameras) {
+    check_object_name(c.id, "camera", file);
+    if (!seen.insert(c.id).second)
+      throw bad_input(fmt::format("session '{}': camera id '{}' appears twice", file.string(), c.id));
+    if (c.width <= 0 || c.height <= 0)
+      throw bad_input(fmt::format("session '{}': camera {} has size {} x {}; width and height must be > 0",
+                                  file.string(), c.id, c.width, c.height));
+  }
+}
+
+// Refuses to start unless the final file could be created: nothing is written before this.
+void check_destination(const fs::path& path, bool overwrite) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec))
+    throw bad_input(fmt::format("cannot write session '{}': it is a folder", path.string()));
+  if (fs::exists(path, ec) && !overwrite)
+    throw bad_input(fmt::format("session file '{}' already exists; choose another name or allow overwriting "
+                                "(--overwrite)",
+                                path.string()));
+  const fs::path folder = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  if (!fs::exists(folder, ec))
+    throw bad_input(fmt::format("cannot write session '{}': folder '{}' does not exist", path.string(),
+                                folder.string()));
+  if (!fs::is_directory(folder, ec))
+    throw bad_input(fmt::format("cannot write session '{}': '{}' is not a folder", path.string(), folder.string()));
+}
+
+std::string describe_image(const Image& image) {
+  return fmt::format("{} x {} {}", image.width(), image.height(), to_string(image.type()));
+}
+
+}  // namespace
+
+struct SessionWriter::Impl {
+  struct CameraStream {
+    SessionCamera camera;
+    h5::GrowingDataset frames;
+    hid_t mem_type = H5T_NATIVE_UINT8;
+    std::array<hsize_t, 4> count{};  // one frame: {1, 1, height, width}
+  };
+
+  Impl(const fs::path& path, const SessionInfo& info, const SessionWriterOptions& options);
+
+  void create_layout(const SessionInfo& info);
+  void create_camera(const SessionCamera& camera, std::size_t index, hid_t cameras_group);
+  void create_set_datasets();
+  // Checks every frame of `set` and fills frames_/timestamps_/present_; throws bad_input
+  // before anything is written.
+  void collect(const FrameSet& set);
+  void write_collected(const FrameSet& set);
+  std::size_t camera_index(const std::string& id) const;
+  h5::Group ensure_group(hid_t parent, const char* name, const std::string& where);
+  void require_open(const char* action) const;
+  [[noreturn]] void fail_write(const std::string& action, const h5::Failure& failure);
+
+  // Declaration order matters: members are destroyed in reverse, so every dataset is closed,
+  // then the file, and only then does `partial` delete the file if it was not finished.
+  PartialFile partial;
+  fs::path final_path;
+  SessionWriterOptions options;
+  h5::File file;
+  std::vector<CameraStream> streams;
+  std::unordered_map<std::string, std::size_t> index_of;
+  h5::GrowingDataset trigger_index, trigger_timestamp, dt, frame_timestamp, frame_present;
+
+  // Per-set scratch, reused so that append() does not allocate in the steady state.
+  std::vector<const Frame*> frames_;        // [camera * 2 + exposure], null if missing
+  std::vector<std::int64_t> timestamps_;    // same indexing
+  std::vector<std::uint8_t> present_;       // same indexing
+  std::vector<char> seen_;                  // per camera
+  std::vector<std::byte> staging_;          // for images whose rows are not contiguous
+
+  bool truth_written = false;
+  std::unordered_set<std::uint64_t> truth_sets;
+  std::uint64_t sets = 0;
+  bool finished = false;
+  bool failed = false;
+};
+
+SessionWriter::Impl::Impl(const fs::path& path, const SessionInfo& info, const SessionWriterOptions& opts)
+    : partial(fs::path(path).concat(".partial")), final_path(path), options(opts) {
+  check_cameras(info.cameras, final_path);
+  check_destination(final_path, options.overwrite);
+  if (options.compression != Compression::none)
+    require_filter(kBitshuffleFilterId, fmt::format("writing session '{}' with {} compression", final_path.string(),
+                                                    to_string(options.compression)));
+
+  // SEMI: closing the file fails if an object is still open, instead of silently leaving the
+  // file open (and unflushed) until the last object closes; it catches handle leaks in finish().
+  h5::PropertyList fapl(h5::check(H5Pcreate(H5P_FILE_ACCESS), "cannot create", "a file access list"));
+  h5::check(H5Pset_fclose_degree(fapl.get(), H5F_CLOSE_SEMI), "cannot configure", "a file access list");
+  const hid_t id = H5Fcreate(partial.path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get());
+  if (id < 0)
+    throw bad_input(fmt::format("cannot create session file '{}' (is folder '{}' writable?): {}",
+                                partial.path().string(), partial.path().parent_path().string(),
+                                h5::error_stack_text()));
+  file = h5::File(id);
+  partial.arm();
+
+  try {
+    create_layout(info);
+  } catch (const h5::Failure& failure) {
+    throw runtime_error(fmt::format("cannot create the layout of session '{}': {}", partial.path().string(),
+                                    failure.what()));
+  }
+  const std::size_t n = streams.size();
+  frames_.resize(2 * n);
+  timestamps_.resize(2 * n);
+  present_.resize(2 * n);
+  seen_.resize(n);
+}
+
+void SessionWriter::Impl::create_layout(const SessionInfo& info) {
+  const hid_t root = file.get();
+  h5::write_string_attr(root, layout::kAttrFormat, layout::kFormatName, "/");
+  h5::write_int_attr(root, layout::kAttrFormatVersion, layout::kFormatVersion, H5T_STD_I32LE, "/");
+  h5::write_string_attr(root, layout::kAttrSoftwareVersion,
+                        info.software_version.empty() ? software_version() : info.software_version, "/");
+  h5::write_string_attr(root, layout::kAttrCreatedUtc,
+                        info.created_utc.empty() ? utc_now_iso8601() : info.created_utc, "/");
+  h5::write_string_attr(root, layout::kAttrCompression, to_string(options.compression), "/");
+  h5::write_string_dataset(root, layout::kConfig, info.rig_config_toml, "/config");
+
+  h5::Group cameras = h5::create_group(root, layout::kCameras, "/cameras");
+  std::vector<std::string> order;
+  for (const auto& c : info.cameras) order.push_back(c.id);
+  h5::write_string_list_attr(cameras.get(), layout::kAttrOrder, order, "/cameras");
+  for (std::size_t i = 0; i < info.cameras.size(); ++i) create_camera(info.cameras[i], i, cameras.get());
+  create_set_datasets();
+}
+
+void SessionWriter::Impl::create_camera(const SessionCamera& camera, std::size_t index, hid_t cameras_group) {
+  const std::string where = layout::camera_path(camera.id);
+  h5::Group group = h5::create_group(cameras_group, camera.id.c_str(), where);
+  h5::write_int_attr(group.get(), layout::kAttrWidth, camera.width, H5T_STD_I32LE, where);
+  h5::write_int_attr(group.get(), layout::kAttrHeight, camera.height, H5T_STD_I32LE, where);
+  h5::write_string_attr(group.get(), layout::kAttrPixelFormat, to_string(camera.pixel_format), where);
+  h5::write_double_attr(group.get(), layout::kAttrPixelPitch, camera.pixel_pitch_um, where);
+  h5::write_int_attr(group.get(), layout::kAttrIndex, static_cast<std::int64_t>(index), H5T_STD_I32LE, where);
+
+  h5::PropertyList dcpl(h5::check(H5Pcreate(H5P_DATASET_CREATE), "cannot create", where));
+  add_compression_filter(dcpl.get(), options.compression, "writing session '" + final_path.string() + "'");
+  const auto h = static_cast<hsize_t>(camera.height);
+  const auto w = static_cast<hsize_t>(camera.width);
+  h5::GrowingDataset::Options o;
+  o.file_type = layout::file_sample_type(camera.pixel_format);
+  o.record_shape = {2, h, w};
+  o.chunk = {1, 1, h, w};  // one frame per chunk: a frame is written and read whole
+  o.dcpl = dcpl.get();
+  // Every chunk is written exactly once, in full: caching it would only add a copy.
+  o.chunk_cache = false;
+
+  CameraStream stream;
+  stream.camera = camera;
+  stream.frames = h5::GrowingDataset(group.get(), layout::kFrames, layout::frames_path(camera.id), o);
+  stream.mem_type = layout::memory_sample_type(sample_type_of(camera.pixel_format));
+  stream.count = {1, 1, h, w};
+  index_of.emplace(camera.id, streams.size());
+  streams.push_back(std::move(stream));
+}
+
+void SessionWriter::Impl::create_set_datasets() {
+  h5::Group group = h5::create_group(file.get(), layout::kSets, "/sets");
+  const hsize_t n_cams = streams.size();
+  auto make = [&](const char* name, hid_t type, std::vector<hsize_t> record_shape) {
+    h5::GrowingDataset::Options o;
+    o.file_type = type;
+    o.record_shape = record_shape;
+    o.chunk = {layout::kSetsPerChunk};
+    o.chunk.insert(o.chunk.end(), record_shape.begin(), record_shape.end());
+    return h5::GrowingDataset(group.get(), name, layout::sets_path(name), o);
+  };
+  trigger_index = make(layout::kTriggerIndex, H5T_STD_U64LE, {});
+  trigger_timestamp = make(layout::kTriggerTimestamp, H5T_STD_I64LE, {});
+  dt = make(layout::kDt, H5T_STD_I64LE, {});
+  frame_timestamp = make(layout::kFrameTimestamp, H5T_STD_I64LE, {n_cams, 2});
+  frame_present = make(layout::kFramePresent, H5T_STD_U8LE, {n_cams, 2});
+}
+
+std::size_t SessionWriter::Impl::camera_index(const std::string& id) const {
+  const auto it = index_of.find(id);
+  return it == index_of.end() ? streams.size() : it->second;
+}
+
+void SessionWriter::Impl::require_open(const char* action) const {
+  if (finished)
+    throw runtime_error(fmt::format("cannot {}: session '{}' is already finished", action, final_path.string()));
+  if (failed)
+    throw runtime_error(fmt::format("cannot {}: an earlier write to session '{}' failed", action,
+                                    partial.path().string()));
+}
+
+void SessionWriter::Impl::fail_write(const std::string& action, const h5::Failure& failure) {
+  failed = true;  // datasets may now disagree in length; the file must not be finished
+  throw runtime_error(fmt::format("{} session '{}' failed: {}", action, partial.path().string(), failure.what()));
+}
+
+void SessionWriter::Impl::collect(const FrameSet& set) {
+  std::fill(frames_.begin(), frames_.end(), nullptr);
+  std::fill(timestamps_.begin(), timestamps_.end(), 0);
+  std::fill(present_.begin(), present_.end(), 0);
+  std::fill(seen_.begin(), seen_.end(), 0);
+  for (std::size_t k = 0; k < set.cameras.size(); ++k) {
+    const CameraFrames& frames = set.cameras[k];
+    // Sets normally list cameras in session order; the map is the fallback.
+    const std::size_t c = k < streams.size() && streams[k].camera.id == frames.camera_id
+                              ? k
+                              : camera_index(frames.camera_id);
+    if (c == streams.size()) {
+      std::string known;
+      for (const auto& s : streams) known += (known.empty() ? "" : ", ") + s.camera.id;
+      throw bad_input(fmt::format("set {} has frames for camera '{}', which is not in session '{}' (cameras: {})",
+                                  sets, frames.camera_id, final_path.string(), known));
+    }
+    if (seen_[c]) throw bad_input(fmt::format("set {} lists camera {} twice", sets, frames.camera_id));
+    seen_[c] = 1;
+    const SessionCamera& camera = streams[c].camera;
+    for (const Exposure e : {Exposure::A, Exposure::B}) {
+      const Frame& frame = frames[e];
+      const std::size_t slot = 2 * c + static_cast<std::size_t>(e);
+      timestamps_[slot] = frame.timestamp_ns;
+      if (!frame.present()) continue;
+      const Image& image = frame.image;
+      if (image.width() != camera.width || image.height() != camera.height ||
+          image.type() != sample_type_of(camera.pixel_format))
+        throw bad_input(fmt::format("camera {}, set {}, frame {}: image is {} but session '{}' expects {} x {} {} "
+                                    "({})",
+                                    camera.id, sets, e == Exposure::A ? 'A' : 'B', describe_image(image),
+                                    final_path.string(), camera.width, camera.height,
+                                    to_string(sample_type_of(camera.pixel_format)), to_string(camera.pixel_format)));
+      frames_[slot] = &frame;
+      present_[slot] = 1;
+    }
+  }
+}
+
+void SessionWriter::Impl::write_collected(const FrameSet& set) {
+  const hsize_t index = sets;
+  const hsize_t n = sets + 1;
+  for (auto& s : streams) s.frames.grow_to(n);
+  for (auto* d : {&trigger_index, &trigger_timestamp, &dt, &frame_timestamp, &frame_present}) d->grow_to(n);
+
+  for (std::size_t c = 0; c < streams.size(); ++c) {
+    CameraStream& s = streams[c];
+    for (hsize_t e = 0; e < 2; ++e) {
+      const Frame* frame = frames_[2 * c + e];
+      if (frame == nullptr) continue;  // missing: its chunk is never allocated (reads as 0)
+      const Image& image = frame->image;
+      const std::byte* data = image.data();
+      if (!image.contiguous()) {
+        staging_.resize(image.size_bytes());
+        image.copy_to(staging_);
+        data = staging_.data();
+      }
+      const std::array<hsize_t, 4> offset{index, e, 0, 0};
+      s.frames.write(offset, s.count, s.mem_type, data);
+    }
+  }
+  trigger_index.write_record(index, H5T_NATIVE_UINT64, &set.trigger_index);
+  trigger_timestamp.write_record(index, H5T_NATIVE_INT64, &set.trigger_timestamp_ns);
+  dt.write_record(index, H5T_NATIVE_INT64, &set.dt_ns);
+  frame_timestamp.write_record(index, H5T_NATIVE_INT64, timestamps_.data());
+  frame_present.write_record(index, H5T_NATIVE_UINT8, present_.data());
+  sets = n;
+}
+
+// /truth and its children are created on first use: write_truth and write_truth_set may be
+// called in either order.
+h5::Group SessionWriter::Impl::ensure_group(hid_t parent, const char* name, const std::string& where) {
+  if (h5::link_exists(parent, name)) return h5::open_group(parent, name, where);
+  return h5::create_group(parent, name, where);
+}
+
+SessionWriter::SessionWriter(const fs::path& path, const SessionInfo& info, const SessionWriterOptions& options) {
+  h5::silence_errors();
+  impl_ = std::make_unique<Impl>(path, info, options);
+}
+
+SessionWriter::~SessionWriter() = default;
+
+void SessionWriter::append(const FrameSet& set) {
+  h5::silence_errors();
+  Impl& m = *impl_;
+  m.require_open("append a set");
+  m.collect(set);
+  try {
+    m.write_collected(set);
+  } catch (const h5::Failure& failure) {
+    m.fail_write(fmt::format("writing set {} to", m.sets), failure);
+  }
+}
+
+void SessionWriter::write_truth(const SessionTruth& truth) {
+  h5::silence_errors();
+  Impl& m = *impl_;
+  m.require_open("write truth");
+  if (m.truth_written)
+    throw runtime_error(fmt::format("truth of session '{}' is already written", m.final_path.string()));
+  std::unordered_set<std::string> seen;
+  for (const auto& c : truth.cameras) {
+    check_object_name(c.id, "truth camera", m.final_path);
+    if (!seen.insert(c.id).second)
+      throw bad_input(fmt::format("session '{}': truth camera id '{}' appears twice", m.final_path.string(), c.id));
+  }
+  try {
+    h5::Group group = m.ensure_group(m.file.get(), layout::kTruth, "/truth");
+    h5::write_string_attr(group.get(), layout::kAttrCase, truth.case_name, "/truth");
+    h5::write_string_attr(group.get(), layout::kAttrFlow, truth.flow_name, "/truth");
+    h5::write_string_attr(group.get(), layout::kAttrFlowParameters, truth.flow_parameters, "/truth");
+    h5::write_uint64_attr(group.get(), layout::kAttrSeed, truth.seed, "/truth");
+    h5::write_double_attr(group.get(), layout::kAttrPpp, truth.ppp, "/truth");
+
+    h5::Group cameras = m.ensure_group(group.get(), layout::kCameras, "/truth/cameras");
+    std::vector<std::string> order;
+    for (const auto& c : truth.cameras) order.push_back(c.id);
+    h5::write_string_list_attr(cameras.get(), layout::kAttrOrder, order, "/truth/cameras");
+    const hsize_t mat_dims[2] = {3, 3};
+    const hsize_t vec_dims[1] = {3};
+    for (const auto& c : truth.cameras) {
+      const std::string where = "/truth/cameras/" + c.id;
+      h5::Group g = h5::create_group(cameras.get(), c.id.c_str(), where);
+      h5::write_string_attr(g.get(), layout::kAttrModel, c.model, where);
+      h5::write_doubles_attr(g.get(), layout::kAttrK, c.K, mat_dims, where);
+      h5::write_doubles_attr(g.get(), layout::kAttrR, c.R, mat_dims, where);
+      const std::array<double, 3> t{c.t.x, c.t.y, c.t.z};
+      h5::write_doubles_attr(g.get(), layout::kAttrT, t, vec_dims, where);
+      h5::write_int_attr(g.get(), layout::kAttrWidth, c.width, H5T_STD_I32LE, where);
+      h5::write_int_attr(g.get(), layout::kAttrHeight, c.height, H5T_STD_I32LE, where);
+    }
+  } catch (const h5::Failure& failure) {
+    m.fail_write("writing truth to", failure);
+  }
+  m.truth_written = true;
+}
+
+void SessionWriter::write_truth_set(std::uint64_t set_index, const TruthSet& truth) {
+  static_assert(sizeof(Vec3d) == 3 * sizeof(double), "Vec3d is written as 3 packed doubles");
+  h5::silence_errors();
+  Impl& m = *impl_;
+  m.require_open("write truth");
+  if (m.truth_sets.contains(set_index))
+    throw runtime_error(fmt::format("truth for set {} of session '{}' is already written", set_index,
+                                    m.final_path.string()));
+  try {
+    h5::Group truth_group = m.ensure_group(m.file.get(), layout::kTruth, "/truth");
+    h5::Group sets = m.ensure_group(truth_group.get(), layout::kSets, "/truth/sets");
+    const std::string where = layout::truth_set_path(set_index);
+    h5::Group g = h5::create_group(sets.get(), layout::truth_set_name(set_index).c_str(), where);
+    for (const auto& [name, particles] : {std::pair{layout::kParticlesA, &truth.particles_a},
+                                          std::pair{layout::kParticlesB, &truth.particles_b}}) {
+      const hsize_t dims[2] = {particles->size(), 3};
+      h5::write_dataset(g.get(), name, H5T_IEEE_F64LE, dims, H5T_NATIVE_DOUBLE, particles->data(),
+                        where + "/" + name);
+    }
+  } catch (const h5::Failure& failure) {
+    m.fail_write("writing truth to", failure);
+  }
+  m.truth_sets.insert(set_index);
+}
+
+void SessionWriter::finish() {
+  h5::silence_errors();
+  Impl& m = *impl_;
+  m.require_open("finish");
+  const std::string partial = m.partial.path().string();
+  bool closed = true;
+  for (auto& s : m.streams) closed &= s.frames.close() >= 0;
+  for (auto* d : {&m.trigger_index, &m.trigger_timestamp, &m.dt, &m.frame_timestamp, &m.frame_present})
+    closed &= d->close() >= 0;
+  closed &= m.file.close() >= 0;  // flushes everything to disk
+  if (!closed) {
+    m.failed = true;
+    throw runtime_error(fmt::format("closing session '{}' failed, so it may be incomplete (is the disk full?): {}",
+                                    partial, h5::error_stack_text()));
+  }
+  std::error_code ec;
+  if (!m.options.overwrite && fs::exists(m.final_path, ec)) {
+    m.failed = true;
+    throw bad_input(fmt::format("session file '{}' appeared while it was being written; not replacing it",
+                                m.final_path.string()));
+  }
+  fs::rename(m.partial.path(), m.final_path, ec);
+  if (ec) {
+    m.failed = true;
+    throw runtime_error(fmt::format("cannot rename '{}' to '{}': {}", partial, m.final_path.string(), ec.message()));
+  }
+  m.partial.release();
+  m.finished = true;
+}
+
+std::uint64_t SessionWriter::sets_written() const { return impl_->sets; }
+const fs::path& SessionWriter::path() const { return impl_->final_path; }
+const fs::path& SessionWriter::partial_path() const { return impl_->partial.path(); }
+
+}  // namespace tomorig::storage
