@@ -65,9 +65,16 @@ void run(const RunOptions& opt) {
 
   fmt::print("tomorig run: rig '{}', {} cameras, {} sets, case {} at {} ppp\n", rig.name, rig.cameras.size(),
              rig.simulation->sets, rig.simulation->case_name, rig.simulation->ppp);
-  const SimulationSummary summary = run_simulation_to_session(rig, out, *compression, opt.overwrite);
-  fmt::print("recorded {} sets ({} particles per set) to {} in {:.2f} s ({:.1f} MB)\n", summary.sets,
-             summary.particles_per_set, summary.output.string(), summary.seconds, summary.bytes / 1e6);
+  const auto started = std::chrono::steady_clock::now();
+  auto progress = [started](std::uint64_t done, std::uint64_t total, double /*set_seconds*/) {
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    const double eta = done > 0 ? elapsed / static_cast<double>(done) * static_cast<double>(total - done) : 0.0;
+    fmt::print(stderr, "\rrecording: set {}/{}  {:.1f} sets/s  ETA {:.1f} s", done, total,
+               elapsed > 0 ? static_cast<double>(done) / elapsed : 0.0, eta);
+    if (done == total) fmt::print(stderr, "\n");
+  };
+  const SimulationSummary summary = run_simulation_to_session(rig, out, *compression, opt.overwrite, progress);
+  fmt::print("{}\n", summary.brief());
   fmt::print("next: tomorig inspect {}\n", summary.output.string());
 }
 

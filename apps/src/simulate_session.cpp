@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <future>
 #include <utility>
 
 #include <fmt/core.h>
@@ -141,15 +142,21 @@ SimulationSummary run_simulation_to_session(const config::RigConfig& rig, const 
   for (const sim::SimulatedCamera& cam : simulated.cameras()) truth.cameras.push_back(truth_camera(cam));
   writer.write_truth(truth);
 
+  // Render set k + 1 while set k is written: the two take similar time on tpiv-thesis, and
+  // the writer is single-threaded. At most two sets are in memory.
+  auto render = [&simulated](int k) { return simulated.render_set(static_cast<std::uint64_t>(k)); };
+  std::future<sim::SimulatedSet> next = std::async(std::launch::async, render, 0);
+  auto previous_done = Clock::now();
   for (int k = 0; k < sets; ++k) {
-    const auto set_start = Clock::now();
-    sim::SimulatedSet set = simulated.render_set(static_cast<std::uint64_t>(k));
+    sim::SimulatedSet set = next.get();
+    if (k + 1 < sets) next = std::async(std::launch::async, render, k + 1);
     writer.append(set.frames);
     storage::TruthSet truth_set;
     truth_set.particles_a = std::move(set.particles_a);
     truth_set.particles_b = std::move(set.particles_b);
     writer.write_truth_set(static_cast<std::uint64_t>(k), truth_set);
-    if (progress) progress(static_cast<std::uint64_t>(k) + 1, static_cast<std::uint64_t>(sets), seconds_since(set_start));
+    if (progress) progress(static_cast<std::uint64_t>(k) + 1, static_cast<std::uint64_t>(sets), seconds_since(previous_done));
+    previous_done = Clock::now();
   }
   writer.finish();
 

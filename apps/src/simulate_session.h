@@ -26,8 +26,8 @@ struct SimulationSummary {
   std::string brief() const;
 };
 
-// Called after each set is rendered and written: `done` of `total` sets, and the seconds that
-// set took.
+// Called after each set is rendered and written: `done` of `total` sets, and the seconds since
+// the previous set was written (rendering overlaps writing, so this is the cost per set).
 using SimulationProgress = std::function<void(std::uint64_t done, std::uint64_t total, double set_seconds)>;
 
 // The simulator options a rig config describes: its [simulation] section, its cameras (all

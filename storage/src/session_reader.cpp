@@ -2,6 +2,7 @@
 // at open with one clear message instead of half-way through processing) and reads sets.
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -113,8 +114,10 @@ void SessionReader::Impl::open_file() {
   const hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   if (id < 0) {
     const std::string reason = h5::error_stack_text();
+    std::string lower = reason;
+    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
     // HDF5 1.10 locks files; a writer that has the file open holds the lock.
-    if (reason.find("lock") != std::string::npos)
+    if (lower.find("unable to lock") != std::string::npos)
       throw bad_input(fmt::format("session file '{}' is locked by another program (is it still being written?): {}",
                                   path.string(), reason));
     corrupt(fmt::format("HDF5 cannot open it: {}", reason));

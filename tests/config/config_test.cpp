@@ -311,6 +311,7 @@ TEST(RigIssues, TypeErrors) {
   expect_issue(rig_with("", "[trigger]\nbackend = \"simulated\"\nrate_hz = \"fast\"\n"), "trigger.rate_hz",
                "rate_hz", "expected a number, got string \"fast\"");
   expect_issue(rig_with("", "[grid]\nnx = 2.5\n"), "grid.nx", "nx = 2.5", "expected an integer, got float 2.5");
+  expect_issue(rig_with("", "[grid]\nny = 512.0\n"), "grid.ny", "ny", "expected an integer, got float 512.0");
   expect_issue(rig_with("", "[simulation]\nnoise = 1\n"), "simulation.noise", "noise = 1",
                "expected a boolean (true or false), got integer 1");
   expect_issue("name = 3\n" + rig_with(), "name", "name = 3", "expected a string, got integer 3");

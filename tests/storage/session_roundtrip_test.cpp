@@ -60,7 +60,9 @@ void expect_vec_eq(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b) {
 void expect_same_frame(const Frame& got, const Frame& want, const std::string& what) {
   EXPECT_EQ(got.timestamp_ns, want.timestamp_ns) << what;
   ASSERT_EQ(got.present(), want.present()) << what;
-  if (want.present()) EXPECT_TRUE(got.image.same_pixels(want.image)) << what;
+  if (want.present()) {
+    EXPECT_TRUE(got.image.same_pixels(want.image)) << what;
+  }
 }
 
 class RoundTrip : public ::testing::TestWithParam<std::tuple<PixelFormat, Compression>> {};
