@@ -111,7 +111,7 @@ void add_simulate_command(CLI::App& root) {
   flags->ppp_opt = cmd->add_option("--ppp", flags->ppp, "particle images per pixel, in (0, 1]");
   flags->sets_opt = cmd->add_option("--sets", flags->sets, "number of double-frame sets to render");
   flags->seed_opt = cmd->add_option("--seed", flags->seed, "random seed (recorded in the truth)");
-  cmd->add_option("--out", flags->out, "session file to write (.h5)")->required();
+  cmd->add_option("-o,--out", flags->out, "session file to write (.h5)")->required();
   cmd->add_option("--config", flags->config, "rig config (TOML); default: the embedded tpiv-thesis rig");
   cmd->add_flag("--noise", flags->noise, "add shot and read noise");
   flags->bit_depth_opt = cmd->add_option("--bit-depth", flags->bit_depth, "sensor bit depth: 12 or 16");

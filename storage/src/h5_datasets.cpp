@@ -1,7 +1,6 @@
 #include "h5_datasets.h"
 
 #include "h5_error.h"
-#include <cstdlib>
 #include "h5_strings.h"
 
 namespace tomorig::storage::h5 {
@@ -21,6 +20,24 @@ Dataset open_dataset(hid_t location, const char* name, std::string_view where) {
   if (!link_exists(location, name)) throw Failure(std::string(where) + " is missing");
   return Dataset(check(H5Dopen2(location, name, H5P_DEFAULT), "cannot open", where));
 }
+
+namespace {
+PropertyList access_list(std::size_t cache_bytes, std::string_view where) {
+  PropertyList dapl(check(H5Pcreate(H5P_DATASET_ACCESS), "cannot create an access list for", where));
+  // w0 = 1: evict fully written or read chunks first; they will not be touched again.
+  check(H5Pset_chunk_cache(dapl.get(), H5D_CHUNK_CACHE_NSLOTS_DEFAULT, cache_bytes, 1.0),
+        "cannot set the chunk cache of", where);
+  return dapl;
+}
+}  // namespace
+
+Dataset open_dataset(hid_t location, const char* name, std::size_t cache_bytes, std::string_view where) {
+  if (!link_exists(location, name)) throw Failure(std::string(where) + " is missing");
+  PropertyList dapl = access_list(cache_bytes, where);
+  return Dataset(check(H5Dopen2(location, name, dapl.get()), "cannot open", where));
+}
+
+std::size_t frame_chunk_cache_bytes(bool filtered, std::size_t chunk_bytes) { return filtered ? chunk_bytes : 0; }
 
 std::vector<hsize_t> dims_of(hid_t dataset, std::string_view where) {
   Dataspace space(check(H5Dget_space(dataset), "cannot read the shape of", where));
@@ -117,11 +134,9 @@ GrowingDataset::GrowingDataset(hid_t location, const char* name, std::string whe
   PropertyList dcpl(check(options.dcpl == H5P_DEFAULT ? H5Pcreate(H5P_DATASET_CREATE) : H5Pcopy(options.dcpl),
                           "cannot create", where_));
   check(H5Pset_chunk(dcpl.get(), rank, options.chunk.data()), "cannot set the chunk shape of", where_);
-  if (getenv("FILL_NEVER")) H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_NEVER);
-  PropertyList dapl(check(H5Pcreate(H5P_DATASET_ACCESS), "cannot create", where_));
-  if (getenv("CACHE_BIG")) H5Pset_chunk_cache(dapl.get(), 521, std::atoi(getenv("CACHE_BIG")) * 2101248u, 1.0); else if (!options.chunk_cache)
-    check(H5Pset_chunk_cache(dapl.get(), H5D_CHUNK_CACHE_NSLOTS_DEFAULT, 0, H5D_CHUNK_CACHE_W0_DEFAULT),
-          "cannot set the chunk cache of", where_);
+  PropertyList dapl = options.chunk_cache_bytes == kDefaultCache
+                          ? PropertyList(check(H5Pcreate(H5P_DATASET_ACCESS), "cannot create", where_))
+                          : access_list(options.chunk_cache_bytes, where_);
   dataset_ = Dataset(check(H5Dcreate2(location, name, options.file_type, space.get(), H5P_DEFAULT, dcpl.get(),
                                       dapl.get()),
                            "cannot create", where_));

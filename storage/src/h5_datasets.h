@@ -3,6 +3,7 @@
 // h5::Failure.
 #include <hdf5.h>
 
+#include <cstddef>
 #include <span>
 #include <string>
 #include <string_view>
@@ -17,6 +18,17 @@ Group create_group(hid_t location, const char* name, std::string_view where);
 // Throws Failure("<where> is missing") if there is no such group.
 Group open_group(hid_t location, const char* name, std::string_view where);
 Dataset open_dataset(hid_t location, const char* name, std::string_view where);
+// Same, with a chunk cache of `cache_bytes` for this dataset.
+Dataset open_dataset(hid_t location, const char* name, std::size_t cache_bytes, std::string_view where);
+
+// Chunk cache for a dataset of whole-frame chunks, measured with 1024 x 1024 uint16 frames
+// on the 2-core build machine (figures in docs/file-formats.md, "Performance"):
+//  - unfiltered: 0, no cache. HDF5 then writes and reads a whole chunk straight from and to
+//    the caller's buffer; a cache only adds a copy (2-3x slower).
+//  - filtered: exactly one chunk. Without a cache HDF5 runs the filter through freshly
+//    allocated, zero-filled buffers per chunk (160 MB/s with bitshuffle-LZ4); with room for
+//    one chunk it reuses them (450-700 MB/s); room for more chunks is slower again.
+std::size_t frame_chunk_cache_bytes(bool filtered, std::size_t chunk_bytes);
 
 std::vector<hsize_t> dims_of(hid_t dataset, std::string_view where);
 
@@ -47,8 +59,11 @@ class GrowingDataset {
     std::vector<hsize_t> record_shape;  // dimensions after the first
     std::vector<hsize_t> chunk;         // full chunk shape, first dimension included
     hid_t dcpl = H5P_DEFAULT;           // filters; the chunk shape is added to a copy
-    bool chunk_cache = true;            // false: write chunks straight through, no caching
+    // Chunk cache size in bytes; kDefaultCache keeps HDF5's default (1 MiB). See
+    // frame_chunk_cache_bytes() for why frames set it.
+    std::size_t chunk_cache_bytes = kDefaultCache;
   };
+  static constexpr std::size_t kDefaultCache = static_cast<std::size_t>(-1);
 
   GrowingDataset() = default;
   GrowingDataset(hid_t location, const char* name, std::string where, const Options& options);

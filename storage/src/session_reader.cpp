@@ -68,7 +68,8 @@ struct SessionReader::Impl {
   void open_file();
   void read_root();
   void read_cameras();
-  void check_filters(hid_t dataset, const std::string& where) const;
+  // Returns whether the dataset has any filter (compression).
+  bool check_filters(hid_t dataset, const std::string& where) const;
   void read_sets();
   template <typename T>
   std::vector<T> read_set_dataset(hid_t group, const char* name, hid_t mem_type, std::vector<hsize_t> record_shape);
@@ -187,6 +188,7 @@ void SessionReader::Impl::read_cameras() {
     ds.where = layout::frames_path(id);
     ds.frames = h5::open_dataset(cam.get(), layout::kFrames, ds.where);
     const std::vector<hsize_t> dims = h5::dims_of(ds.frames.get(), ds.where);
+    const bool filtered = check_filters(ds.frames.get(), ds.where);
     if (dims.size() != 4 || dims[1] != 2)
       invalid(fmt::format("{} should have shape [sets, 2, height, width] but has {} dimensions{}", ds.where,
                           dims.size(), dims.size() == 4 ? fmt::format(" with {} exposures", dims[1]) : ""));
@@ -194,7 +196,11 @@ void SessionReader::Impl::read_cameras() {
       invalid(fmt::format("camera {}: frames are {} x {} but the session says {} x {}", id, dims[3], dims[2],
                           camera.width, camera.height));
     check_frame_type(ds.frames.get(), camera, ds.where);
-    check_filters(ds.frames.get(), ds.where);
+    // Reopened with a chunk cache suited to whole-frame reads (see frame_chunk_cache_bytes).
+    ds.frames = h5::open_dataset(cam.get(), layout::kFrames,
+                                 h5::frame_chunk_cache_bytes(filtered, dims[2] * dims[3] *
+                                                                           bytes_per_sample(sample_type_of(camera.pixel_format))),
+                                 ds.where);
     if (cameras.empty()) {
       sets = dims[0];
     } else if (dims[0] != sets) {
@@ -211,7 +217,7 @@ void SessionReader::Impl::read_cameras() {
 
 // A compressed session needs its filter plugin to read; say so now rather than fail on the
 // first frame with HDF5's "can't open directory or file" from deep inside the plugin loader.
-void SessionReader::Impl::check_filters(hid_t dataset, const std::string& where) const {
+bool SessionReader::Impl::check_filters(hid_t dataset, const std::string& where) const {
   h5::PropertyList dcpl(h5::check(H5Dget_create_plist(dataset), "cannot read the creation properties of", where));
   const int n = h5::check(H5Pget_nfilters(dcpl.get()), "cannot read the filters of", where);
   for (int i = 0; i < n; ++i) {
@@ -223,6 +229,7 @@ void SessionReader::Impl::check_filters(hid_t dataset, const std::string& where)
     if (filter < 0) h5::fail("cannot read the filters of", where);
     require_filter(filter, fmt::format("reading session '{}'", path.string()));
   }
+  return n > 0;
 }
 
 template <typename T>

@@ -185,8 +185,8 @@ void SessionWriter::Impl::create_camera(const SessionCamera& camera, std::size_t
   o.record_shape = {2, h, w};
   o.chunk = {1, 1, h, w};  // one frame per chunk: a frame is written and read whole
   o.dcpl = dcpl.get();
-  // Every chunk is written exactly once, in full: caching it would only add a copy.
-  o.chunk_cache = false;
+  o.chunk_cache_bytes = h5::frame_chunk_cache_bytes(options.compression != Compression::none,
+                                                     h * w * bytes_per_sample(sample_type_of(camera.pixel_format)));
 
   CameraStream stream;
   stream.camera = camera;
