@@ -15,6 +15,7 @@
 #include "h5_datasets.h"
 #include "h5_error.h"
 #include "h5_handle.h"
+#include "h5_open.h"
 #include "session_layout.h"
 #include "tomorig/core/error.h"
 #include "tomorig/storage/session_file.h"
@@ -103,28 +104,7 @@ SessionReader::Impl::Impl(const fs::path& p) : path(p) {
   }
 }
 
-void SessionReader::Impl::open_file() {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw bad_input(fmt::format("session file '{}' does not exist", path.string()));
-  if (fs::is_directory(path, ec))
-    throw bad_input(fmt::format("'{}' is a folder, not a session file", path.string()));
-  const htri_t is_hdf5 = H5Fis_hdf5(path.c_str());
-  if (is_hdf5 <= 0)
-    throw bad_input(fmt::format("'{}' is not an HDF5 file, so not a tomorig session{}", path.string(),
-                                is_hdf5 < 0 ? fmt::format(" ({})", h5::error_stack_text()) : ""));
-  const hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  if (id < 0) {
-    const std::string reason = h5::error_stack_text();
-    std::string lower = reason;
-    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-    // HDF5 1.10 locks files; a writer that has the file open holds the lock.
-    if (lower.find("unable to lock") != std::string::npos)
-      throw bad_input(fmt::format("session file '{}' is locked by another program (is it still being written?): {}",
-                                  path.string(), reason));
-    corrupt(fmt::format("HDF5 cannot open it: {}", reason));
-  }
-  file = h5::File(id);
-}
+void SessionReader::Impl::open_file() { file = h5::open_for_reading(path, "session file"); }
 
 void SessionReader::Impl::read_root() {
   const hid_t root = file.get();

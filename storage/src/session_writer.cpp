@@ -14,6 +14,7 @@
 #include "h5_datasets.h"
 #include "h5_error.h"
 #include "h5_handle.h"
+#include "output_path.h"
 #include "partial_file.h"
 #include "session_layout.h"
 #include "tomorig/core/error.h"
@@ -46,22 +47,6 @@ void check_cameras(const std::vector<SessionCamera>& cameras, const fs::path& fi
   }
 }
 
-// Refuses to start unless the final file could be created: nothing is written before this.
-void check_destination(const fs::path& path, bool overwrite) {
-  std::error_code ec;
-  if (fs::is_directory(path, ec))
-    throw bad_input(fmt::format("cannot write session '{}': it is a folder", path.string()));
-  if (fs::exists(path, ec) && !overwrite)
-    throw bad_input(fmt::format("session file '{}' already exists; choose another name or allow overwriting "
-                                "(--overwrite)",
-                                path.string()));
-  const fs::path folder = path.parent_path().empty() ? fs::path(".") : path.parent_path();
-  if (!fs::exists(folder, ec))
-    throw bad_input(fmt::format("cannot write session '{}': folder '{}' does not exist", path.string(),
-                                folder.string()));
-  if (!fs::is_directory(folder, ec))
-    throw bad_input(fmt::format("cannot write session '{}': '{}' is not a folder", path.string(), folder.string()));
-}
 
 std::string describe_image(const Image& image) {
   return fmt::format("{} x {} {}", image.width(), image.height(), to_string(image.type()));
@@ -118,7 +103,7 @@ struct SessionWriter::Impl {
 SessionWriter::Impl::Impl(const fs::path& path, const SessionInfo& info, const SessionWriterOptions& opts)
     : partial(fs::path(path).concat(".partial")), final_path(path), options(opts) {
   check_cameras(info.cameras, final_path);
-  check_destination(final_path, options.overwrite);
+  check_output_path(final_path, options.overwrite, "session");
   if (options.compression != Compression::none)
     require_filter(kBitshuffleFilterId, fmt::format("writing session '{}' with {} compression", final_path.string(),
                                                     to_string(options.compression)));

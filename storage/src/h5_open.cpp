@@ -1,0 +1,39 @@
+#include "h5_open.h"
+
+#include <algorithm>
+#include <cctype>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "h5_error.h"
+#include "tomorig/core/error.h"
+
+namespace tomorig::storage::h5 {
+
+File open_for_reading(const std::filesystem::path& path, std::string_view kind) {
+  namespace fs = std::filesystem;
+  silence_errors();
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw bad_input(fmt::format("{} '{}' does not exist", kind, path.string()));
+  if (fs::is_directory(path, ec)) throw bad_input(fmt::format("'{}' is a folder, not a {}", path.string(), kind));
+  const htri_t is_hdf5 = H5Fis_hdf5(path.c_str());
+  if (is_hdf5 <= 0)
+    throw bad_input(fmt::format("'{}' is not an HDF5 file, so not a tomorig {}{}", path.string(), kind,
+                                is_hdf5 < 0 ? fmt::format(" ({})", error_stack_text()) : ""));
+  const hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (id < 0) {
+    const std::string reason = error_stack_text();
+    std::string lower = reason;
+    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+    // HDF5 1.10 locks files; a writer that has the file open holds the lock.
+    if (lower.find("unable to lock") != std::string::npos)
+      throw bad_input(fmt::format("{} '{}' is locked by another program (is it still being written?): {}", kind,
+                                  path.string(), reason));
+    throw bad_input(fmt::format("{} '{}' is corrupt or truncated: HDF5 cannot open it: {}", kind, path.string(),
+                                reason));
+  }
+  return File(id);
+}
+
+}  // namespace tomorig::storage::h5
