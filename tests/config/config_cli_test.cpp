@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include "cli_runner.h"
 #include "tomorig/config/rig_config.h"
 
 namespace tomorig::config {
@@ -20,58 +21,20 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct RunResult {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::string quoted(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
+using testing::CliResult;
+using testing::run_tomorig;
+using RunResult = CliResult;
+std::string quoted(const std::string& s) { return testing::shell_quoted(s); }
 
 class ConfigCli : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (!fs::exists(TOMORIG_BINARY)) GTEST_SKIP() << "tomorig is not built (" << TOMORIG_BINARY << "); build target tomorig";
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / (std::string("tomorig_config_cli_") + info->name() + "_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
+    if (!testing::tomorig_built()) GTEST_SKIP() << "tomorig is not built (" << TOMORIG_BINARY << "); build target tomorig";
   }
-  void TearDown() override {
-    std::error_code ec;
-    if (!dir_.empty()) fs::remove_all(dir_, ec);
-  }
+  RunResult run(const std::string& args) const { return run_tomorig(args); }
+  fs::path write(const std::string& name, const std::string& text) const { return dir_.write(name, text); }
 
-  // Runs `tomorig <args>` (args already shell-quoted) with stdout and stderr captured.
-  RunResult run(const std::string& args) const {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string command = quoted(TOMORIG_BINARY) + " " + args + " >" + quoted(out.string()) + " 2>" +
-                                quoted(err.string()) + " </dev/null";
-    const int status = std::system(command.c_str());
-    RunResult r;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-  }
-
-  fs::path write(const std::string& name, const std::string& text) const {
-    const fs::path file = dir_ / name;
-    std::ofstream(file, std::ios::binary) << text;
-    return file;
-  }
-
-  fs::path dir_;
+  testing::TempDir dir_;
 };
 
 TEST_F(ConfigCli, DefaultPrintsTheEmbeddedRigVerbatim) {

@@ -1,5 +1,6 @@
 // The rig config parser: the embedded default, and every class of problem it reports, each
 // named by key path and line.
+#include "temp_dir.h"
 #include "tomorig/config/rig_config.h"
 
 #include <gtest/gtest.h>
@@ -65,35 +66,8 @@ void expect_issue(const std::string& doc, const std::string& key, const std::str
   EXPECT_EQ(issue->origin, "rig.toml");
 }
 
-std::string read_file(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = std::filesystem::temp_directory_path() /
-            (std::string("tomorig_config_") + info->name() + "_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  const std::filesystem::path& path() const { return path_; }
-  std::filesystem::path write(const std::string& name, const std::string& text) const {
-    const auto file = path_ / name;
-    std::ofstream(file, std::ios::binary) << text;
-    return file;
-  }
-
- private:
-  std::filesystem::path path_;
-};
+using testing::TempDir;
+std::string read_file(const std::filesystem::path& path) { return testing::read_text_file(path); }
 
 // ---- the default rig ----------------------------------------------------------------------
 

@@ -13,6 +13,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "cli_runner.h"
 #include "storage_test_support.h"
 #include "tomorig/storage/session_file.h"
 
@@ -23,39 +24,16 @@ using testing::TempDir;
 using testing::test_camera;
 using testing::test_set;
 
-struct RunResult {
-  int exit_code = -1;
-  std::string out;  // stdout only; stderr goes to err_file
-  std::string err;
-};
-
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
+using RunResult = tomorig::testing::CliResult;
+std::string quote(const std::string& s) { return tomorig::testing::shell_quoted(s); }
 
 class CliTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (!fs::exists(TOMORIG_BINARY)) GTEST_SKIP() << "tomorig binary not built: " << TOMORIG_BINARY;
+    if (!tomorig::testing::tomorig_built()) GTEST_SKIP() << "tomorig binary not built: " << TOMORIG_BINARY;
   }
 
-  RunResult run(const std::string& args) {
-    const fs::path err_file = dir_ / "stderr.txt";
-    const std::string command = quote(TOMORIG_BINARY) + " " + args + " 2>" + quote(err_file.string());
-    RunResult r;
-    FILE* pipe = popen(command.c_str(), "r");
-    if (pipe == nullptr) return r;
-    std::array<char, 4096> buffer{};
-    std::size_t n = 0;
-    while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.out.append(buffer.data(), n);
-    const int status = pclose(pipe);
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    std::ifstream in(err_file);
-    r.err.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    return r;
-  }
+  RunResult run(const std::string& args) { return tomorig::testing::run_tomorig(args); }
 
   TempDir dir_;
 };

@@ -10,33 +10,14 @@
 #include <system_error>
 #include <vector>
 
+#include "temp_dir.h"
 #include "tomorig/core/error.h"
 #include "tomorig/core/frame_set.h"
 #include "tomorig/storage/session_file.h"
 
 namespace tomorig::storage::testing {
 
-// A fresh folder under the system temp folder, removed with everything in it.
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "tomorig-storage-XXXXXX").string();
-    if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    std::filesystem::permissions(path_, std::filesystem::perms::owner_all, std::filesystem::perm_options::add, ignored);
-    std::filesystem::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  std::filesystem::path path_;
-};
+using tomorig::testing::TempDir;
 
 // Pixels that differ between cameras, sets and exposures, and use the full sample range, so
 // that a swapped or truncated frame cannot go unnoticed.

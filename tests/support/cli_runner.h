@@ -10,6 +10,8 @@
 #include <string>
 #include <unistd.h>
 
+#include "temp_dir.h"
+
 namespace tomorig::testing {
 
 struct CliResult {
@@ -18,41 +20,24 @@ struct CliResult {
   std::string err;  // stderr
 };
 
-inline std::string read_text_file(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+// `text` quoted for a POSIX shell, e.g. a path with spaces or quotes.
+inline std::string shell_quoted(const std::string& text) {
+  std::string out = "'";
+  for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
 }
 
-// A fresh temporary folder, removed when the object dies.
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "tomorig-test-XXXXXX").string();
-    if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  std::filesystem::path path_;
-};
+// Whether the tomorig binary exists: a partial build of one suite may not have it, and then
+// CLI tests skip and say so.
+inline bool tomorig_built() { return std::filesystem::exists(TOMORIG_BINARY); }
 
 // `args` is appended to the binary path verbatim (the caller quotes what needs quoting).
 inline CliResult run_tomorig(const std::string& args) {
   TempDir tmp;
   const auto out = tmp / "stdout.txt";
   const auto err = tmp / "stderr.txt";
-  const std::string cmd = std::string("'") + TOMORIG_BINARY + "' " + args + " >'" + out.string() + "' 2>'" +
-                          err.string() + "' </dev/null";
+  const std::string cmd = shell_quoted(TOMORIG_BINARY) + " " + args + " >" + shell_quoted(out.string()) + " 2>" +
+                          shell_quoted(err.string()) + " </dev/null";
   const int status = std::system(cmd.c_str());
   CliResult result;
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
