@@ -1,5 +1,7 @@
 // tomorig inspect FILE [--json]: what a session holds, for people (text) and scripts (JSON).
+#include <filesystem>
 #include <memory>
+#include <vector>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -7,6 +9,9 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "tomorig/core/error.h"
+#include "tomorig/processing/quicklook/display.h"
+#include "tomorig/storage/image_file.h"
 #include "tomorig/storage/session_file.h"
 #include "tomorig/storage/session_summary.h"
 
@@ -16,7 +21,33 @@ namespace {
 struct InspectArgs {
   std::string file;
   bool json = false;
+  std::string png_folder;
+  std::uint64_t set = 0;
 };
+
+// Quick-looks of one set: every present frame, stretched to 8 bits, as
+// <folder>/<camera>_set<k>_<A|B>.png. Returns the files written.
+std::vector<std::filesystem::path> write_quicklooks(const storage::SessionReader& reader, std::uint64_t set_index,
+                                                    const std::filesystem::path& folder) {
+  if (set_index >= reader.set_count())
+    throw bad_input(fmt::format("--set {} is out of range: session '{}' has {} sets", set_index,
+                                reader.path().string(), reader.set_count()));
+  std::error_code ec;
+  std::filesystem::create_directories(folder, ec);
+  if (ec || !std::filesystem::is_directory(folder))
+    throw bad_input(fmt::format("cannot create the quick-look folder '{}': {}; choose another --png", folder.string(),
+                                ec ? ec.message() : "it is not a folder"));
+  const FrameSet set = reader.read_set(set_index);
+  std::vector<std::filesystem::path> written;
+  for (const CameraFrames& camera : set.cameras)
+    for (const Exposure e : {Exposure::A, Exposure::B}) {
+      if (!camera[e].present()) continue;
+      const auto file = folder / fmt::format("{}_set{}_{}.png", camera.camera_id, set_index, e == Exposure::A ? "A" : "B");
+      storage::write_png(file, quicklook::stretch_to_8bit(camera[e].image));
+      written.push_back(file);
+    }
+  return written;
+}
 
 std::string human_size(std::uintmax_t bytes) {
   const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
@@ -99,13 +130,25 @@ void add_inspect_command(CLI::App& root) {
   CLI::App* cmd = root.add_subcommand("inspect", "Summarise a session file: cameras, sets, timing, missing frames");
   cmd->add_option("file", args->file, "Session file (.h5)")->required();
   cmd->add_flag("--json", args->json, "Print one JSON object instead of text");
+  cmd->add_option("--png", args->png_folder,
+                  "Also write 8-bit PNG quick-looks of one set's frames into this folder (created if needed)");
+  cmd->add_option("--set", args->set, "Set for --png, 0-based")->capture_default_str();
   cmd->callback([args] {
     const storage::SessionReader reader(args->file);  // throws bad_input for bad files
     const storage::SessionSummary summary = storage::summarize(reader);
-    if (args->json)
-      fmt::print("{}\n", to_json(summary).dump(2));
-    else
+    std::vector<std::filesystem::path> pngs;
+    if (!args->png_folder.empty()) pngs = write_quicklooks(reader, args->set, args->png_folder);
+    if (args->json) {
+      nlohmann::json j = to_json(summary);
+      if (!args->png_folder.empty()) {
+        j["quicklooks"] = nlohmann::json::array();
+        for (const auto& p : pngs) j["quicklooks"].push_back(p.string());
+      }
+      fmt::print("{}\n", j.dump(2));
+    } else {
       print_text(summary);
+      for (const auto& p : pngs) fmt::print("quick-look   {}\n", p.string());
+    }
   });
 }
 

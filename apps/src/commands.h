@@ -12,5 +12,7 @@ void add_simulate_command(CLI::App& root);  // cmd_simulate.cpp
 void add_inspect_command(CLI::App& root);   // cmd_inspect.cpp
 void add_import_command(CLI::App& root);    // cmd_import.cpp
 void add_run_command(CLI::App& root);       // cmd_run.cpp: the main job on a rig config
+void add_trigger_command(CLI::App& root);   // cmd_trigger.cpp: trigger plan
+void add_reconstruct_command(CLI::App& root);  // cmd_reconstruct.cpp
 
 }  // namespace tomorig::app

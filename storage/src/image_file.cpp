@@ -1,5 +1,6 @@
 #include "tomorig/storage/image_file.h"
 
+#include <cstdio>
 #include <memory>
 #include <string>
 #include <system_error>
@@ -73,6 +74,42 @@ Image read_image(const fs::path& file, int page) {
   } catch (const cv::Exception& e) {
     throw bad_input(fmt::format("cannot read image file '{}': {}", file.string(), e.what()));
   }
+}
+
+}  // namespace tomorig::storage
+
+namespace tomorig::storage {
+
+void write_png(const fs::path& file, const Image& image) {
+  if (image.empty()) throw bad_input(fmt::format("cannot write '{}': the image is empty", file.string()));
+  if (image.type() == SampleType::f32)
+    throw bad_input(fmt::format("cannot write '{}': PNG holds 8- or 16-bit samples, not float; scale the image first",
+                                file.string()));
+  const int cv_type = image.type() == SampleType::u8 ? CV_8UC1 : CV_16UC1;
+  // A header over the pixels, no copy; imencode only reads them.
+  const cv::Mat mat(image.height(), image.width(), cv_type, const_cast<std::byte*>(image.data()), image.stride_bytes());
+  std::vector<uchar> encoded;
+  try {
+    if (!cv::imencode(".png", mat, encoded)) throw bad_input(fmt::format("OpenCV cannot encode '{}'", file.string()));
+  } catch (const cv::Exception& e) {
+    throw bad_input(fmt::format("OpenCV cannot encode '{}': {}", file.string(), e.what()));
+  }
+  const fs::path partial = fs::path(file).concat(".partial");
+  {
+    std::FILE* out = std::fopen(partial.c_str(), "wb");
+    if (out == nullptr)
+      throw bad_input(fmt::format("cannot write '{}': is folder '{}' there and writable?", file.string(),
+                                  file.parent_path().string()));
+    const bool ok = std::fwrite(encoded.data(), 1, encoded.size(), out) == encoded.size();
+    if (std::fclose(out) != 0 || !ok) {
+      std::error_code ignored;
+      fs::remove(partial, ignored);
+      throw runtime_error(fmt::format("writing '{}' failed (is the disk full?)", file.string()));
+    }
+  }
+  std::error_code ec;
+  fs::rename(partial, file, ec);
+  if (ec) throw runtime_error(fmt::format("cannot rename '{}' to '{}': {}", partial.string(), file.string(), ec.message()));
 }
 
 }  // namespace tomorig::storage

@@ -1,7 +1,7 @@
 #pragma once
 // Reading single-channel 8- and 16-bit images written by other tools (TIFF, including
 // multi-page TIFF, PNG, and whatever else OpenCV reads), for imports and calibration
-// targets. OpenCV stays inside storage/src.
+// targets, and writing PNG quick-looks. OpenCV stays inside storage/src.
 #include <filesystem>
 
 #include "tomorig/core/image.h"
@@ -15,5 +15,9 @@ int image_page_count(const std::filesystem::path& file);
 // One page as an owning Image of uint8 or uint16 samples, bit for bit as stored. Throws
 // bad_input naming the file (and page) if it cannot be read or is not single-channel 8/16-bit.
 Image read_image(const std::filesystem::path& file, int page = 0);
+
+// Writes a u8 or u16 image as a lossless PNG (16-bit PNG for u16), through "<file>.partial"
+// and a rename. Throws bad_input for a float image or an unwritable path.
+void write_png(const std::filesystem::path& file, const Image& image);
 
 }  // namespace tomorig::storage

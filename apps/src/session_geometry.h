@@ -1,0 +1,34 @@
+#pragma once
+// What a reconstruction needs from a session besides its pixels: the camera models, in the
+// session's camera order, and the voxel grid. Shared by `reconstruct`, `bench recon` and the
+// back-end pipeline.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "tomorig/core/volume.h"
+#include "tomorig/processing/calibration/camera_model.h"
+#include "tomorig/storage/session_file.h"
+
+namespace tomorig::app {
+
+struct SessionCameras {
+  std::vector<std::unique_ptr<calibration::CameraModel>> models;  // session camera order
+  std::string source;  // "truth of <session>" or the calibration file, for reports
+  std::vector<const calibration::CameraModel*> pointers() const;
+};
+
+// The simulator's exact cameras stored in the session's /truth. Throws tomorig::Error
+// (bad_input) if the session has no truth (then a calibration file is needed) or its truth
+// cameras do not match the session's cameras by id and size.
+SessionCameras truth_cameras(const storage::SessionReader& session);
+
+// The [grid] of the session's rig config, as a VoxelGrid (the config gives the grid centre;
+// VoxelGrid wants the centre of voxel (0, 0, 0)).
+VoxelGrid grid_from_session(const storage::SessionReader& session);
+
+// "nx,ny,nz,voxel_mm" or "nx,ny,nz,voxel_mm,cx,cy,cz" (cx..cz: grid centre, mm; default 0).
+// Throws tomorig::Error (bad_input) quoting `text` and the expected form.
+VoxelGrid parse_grid(const std::string& text);
+
+}  // namespace tomorig::app
