@@ -85,6 +85,7 @@ nlohmann::json to_json(const storage::SessionSummary& s) {
       {"incomplete_sets", s.incomplete_sets},
       {"time_span_s", s.time_span_s},
       {"truth", s.truth},
+      {"recording_complete", s.recording_complete},
   };
   // Values that do not exist for an empty session are null rather than a misleading 0.
   j["dt_ns"] = s.sets == 0 ? json(nullptr) : json{{"min", s.dt_ns_min}, {"max", s.dt_ns_max}};
@@ -114,6 +115,9 @@ void print_text(const storage::SessionSummary& s) {
     else
       fmt::print("dt           {} to {}\n", microseconds(s.dt_ns_min), microseconds(s.dt_ns_max));
   }
+  if (!s.recording_complete)
+    fmt::print("recording    not finished: still being written, or interrupted; the {} sets shown are complete\n",
+               s.sets);
   fmt::print("missing      {} frame{} in {} incomplete set{}\n", s.missing_frames, s.missing_frames == 1 ? "" : "s",
              s.incomplete_sets, s.incomplete_sets == 1 ? "" : "s");
   if (s.truth)

@@ -73,7 +73,7 @@ void run(const RunOptions& opt) {
                elapsed > 0 ? static_cast<double>(done) / elapsed : 0.0, eta);
     if (done == total) fmt::print(stderr, "\n");
   };
-  const SimulationSummary summary = run_simulation_to_session(rig, out, *compression, opt.overwrite, progress);
+  const SimulationSummary summary = run_simulation_to_session(rig, out, *compression, opt.overwrite, progress, /*live=*/true);
   fmt::print("{}\n", summary.brief());
   fmt::print("next: tomorig inspect {}\n", summary.output.string());
 }

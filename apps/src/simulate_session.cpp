@@ -111,7 +111,7 @@ sim::SimulationOptions simulation_options_from(const config::RigConfig& rig) {
 
 SimulationSummary run_simulation_to_session(const config::RigConfig& rig, const std::filesystem::path& out,
                                             storage::Compression compression, bool overwrite,
-                                            const SimulationProgress& progress) {
+                                            const SimulationProgress& progress, bool live) {
   const auto start = Clock::now();
   // Everything that can be wrong with the input is found here, before a file exists.
   const sim::SimulationOptions options = simulation_options_from(rig);
@@ -129,6 +129,7 @@ SimulationSummary run_simulation_to_session(const config::RigConfig& rig, const 
   info.compression = compression;
 
   storage::SessionWriterOptions writer_options;
+  writer_options.live = live;
   writer_options.compression = compression;
   writer_options.overwrite = overwrite;
   storage::SessionWriter writer(out, info, writer_options);

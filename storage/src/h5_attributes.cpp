@@ -64,7 +64,9 @@ void write_string_list_attr(hid_t object, const char* name, const std::vector<st
   for (const auto& v : values) pointers.push_back(v.c_str());
   const hsize_t dims[1] = {values.size()};
   Dataspace space(check(H5Screate_simple(1, dims, nullptr), "cannot create", attr_name(name, where)));
-  write_attr(object, name, type.get(), space.get(), type.get(), pointers.data(), where);
+  // An empty list still needs a non-null buffer: HDF5 refuses a null one even for 0 elements.
+  const char* none = nullptr;
+  write_attr(object, name, type.get(), space.get(), type.get(), values.empty() ? &none : pointers.data(), where);
 }
 
 void write_int_attr(hid_t object, const char* name, std::int64_t value, hid_t file_type, std::string_view where) {

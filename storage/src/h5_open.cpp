@@ -21,7 +21,10 @@ File open_for_reading(const std::filesystem::path& path, std::string_view kind) 
   if (is_hdf5 <= 0)
     throw bad_input(fmt::format("'{}' is not an HDF5 file, so not a tomorig {}{}", path.string(), kind,
                                 is_hdf5 < 0 ? fmt::format(" ({})", error_stack_text()) : ""));
-  const hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  // A live recording (SWMR) refuses plain readers while it is written, and after a crash its
+  // superblock still says "open for writing"; a SWMR reader reads both.
+  if (id < 0) id = H5Fopen(path.c_str(), H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, H5P_DEFAULT);
   if (id < 0) {
     const std::string reason = error_stack_text();
     std::string lower = reason;

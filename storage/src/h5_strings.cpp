@@ -42,6 +42,7 @@ std::vector<std::string> read_strings(hid_t object, StringSource source, std::st
   Datatype mem(check(H5Tcopy(H5T_C_S1), "cannot read", where));
   check(H5Tset_cset(mem.get(), H5Tget_cset(stored.get())), "cannot read", where);
   std::vector<std::string> out;
+  if (count == 0) return out;  // HDF5 rejects a read into a null buffer
   out.reserve(count);
 
   if (H5Tis_variable_str(stored.get()) > 0) {

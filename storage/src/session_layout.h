@@ -21,6 +21,9 @@ inline constexpr const char* kAttrFormatVersion = "format_version";
 inline constexpr const char* kAttrSoftwareVersion = "software_version";
 inline constexpr const char* kAttrCreatedUtc = "created_utc";
 inline constexpr const char* kAttrCompression = "compression";
+// int32 1 once a live recording finished; 0 while it is written (or if it was interrupted).
+// Absent in files written in one go, which are complete by construction.
+inline constexpr const char* kAttrRecordingComplete = "recording_complete";
 
 inline constexpr const char* kConfig = "config";  // scalar string dataset: rig TOML
 

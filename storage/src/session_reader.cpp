@@ -90,6 +90,9 @@ struct SessionReader::Impl {
   int missing = 0;
   int incomplete = 0;
   bool truth = false;
+  // A live recording still being written or interrupted: datasets may differ in length by the
+  // set in progress, and the sets are those every dataset holds.
+  bool recording_complete = true;
 };
 
 SessionReader::Impl::Impl(const fs::path& p) : path(p) {
@@ -137,6 +140,8 @@ void SessionReader::Impl::read_root() {
   }
   if (h5::link_exists(root, layout::kConfig))
     info.rig_config_toml = h5::read_string_dataset(root, layout::kConfig, "/config");
+  if (h5::has_attr(root, layout::kAttrRecordingComplete))
+    recording_complete = h5::read_int_attr(root, layout::kAttrRecordingComplete, "/") != 0;
 }
 
 void SessionReader::Impl::read_cameras() {
@@ -183,6 +188,8 @@ void SessionReader::Impl::read_cameras() {
                                  ds.where);
     if (cameras.empty()) {
       sets = dims[0];
+    } else if (!recording_complete) {
+      sets = std::min<std::uint64_t>(sets, dims[0]);
     } else if (dims[0] != sets) {
       corrupt(fmt::format("camera {} holds {} sets but camera {} holds {}", id, dims[0], info.cameras.front().id,
                           sets));
@@ -223,12 +230,15 @@ std::vector<T> SessionReader::Impl::read_set_dataset(hid_t group, const char* na
   expected.insert(expected.end(), record_shape.begin(), record_shape.end());
   if (dims.size() != expected.size() || !std::equal(dims.begin() + 1, dims.end(), expected.begin() + 1))
     invalid(fmt::format("{} has shape [{}] but should be [{}]", where, fmt::join(dims, ", "), fmt::join(expected, ", ")));
-  if (dims[0] != sets)
+  if (dims[0] != sets && (recording_complete || dims[0] < sets))
     corrupt(fmt::format("{} holds {} sets but the camera frames hold {}", where, dims[0], sets));
+  std::size_t stored = 1;
+  for (hsize_t d : dims) stored *= d;
+  std::vector<T> values(stored);
+  if (stored > 0) h5::read_all(dataset.get(), mem_type, values.data(), where);
   std::size_t n = 1;
   for (hsize_t d : expected) n *= d;
-  std::vector<T> values(n);
-  if (n > 0) h5::read_all(dataset.get(), mem_type, values.data(), where);
+  values.resize(n);  // a live recording may hold the start of the next set
   return values;
 }
 
@@ -236,6 +246,15 @@ void SessionReader::Impl::read_sets() {
   if (!h5::link_exists(file.get(), layout::kSets)) invalid("the group /sets is missing");
   h5::Group group = h5::open_group(file.get(), layout::kSets, "/sets");
   const hsize_t n_cams = cameras.size();
+  if (!recording_complete) {
+    // trigger_index is written last for each set, so it says how many sets are complete.
+    for (const char* name : {layout::kTriggerIndex, layout::kTriggerTimestamp, layout::kDt, layout::kFrameTimestamp,
+                             layout::kFramePresent})
+      if (h5::link_exists(group.get(), name)) {
+        h5::Dataset d = h5::open_dataset(group.get(), name, layout::sets_path(name));
+        sets = std::min<std::uint64_t>(sets, h5::dims_of(d.get(), layout::sets_path(name)).at(0));
+      }
+  }
   trigger_index = read_set_dataset<std::uint64_t>(group.get(), layout::kTriggerIndex, H5T_NATIVE_UINT64, {});
   trigger_timestamp = read_set_dataset<std::int64_t>(group.get(), layout::kTriggerTimestamp, H5T_NATIVE_INT64, {});
   dt = read_set_dataset<std::int64_t>(group.get(), layout::kDt, H5T_NATIVE_INT64, {});
@@ -280,6 +299,7 @@ std::uint64_t SessionReader::set_count() const { return impl_->sets; }
 int SessionReader::missing_frames() const { return impl_->missing; }
 int SessionReader::incomplete_sets() const { return impl_->incomplete; }
 bool SessionReader::has_truth() const { return impl_->truth; }
+bool SessionReader::recording_complete() const { return impl_->recording_complete; }
 
 SetRecord SessionReader::set_record(std::uint64_t set_index) const {
   const Impl& m = *impl_;

@@ -38,6 +38,7 @@ SessionSummary summarize(const SessionReader& reader) {
   }
   s.time_span_s = static_cast<double>(s.last_trigger_ns - s.first_trigger_ns) * 1e-9;
 
+  s.recording_complete = reader.recording_complete();
   s.truth = reader.has_truth();
   if (s.truth) {
     const SessionTruth truth = reader.truth();

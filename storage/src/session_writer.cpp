@@ -1,6 +1,9 @@
 // SessionWriter: creates the layout of docs/file-formats.md in "<path>.partial", appends
 // sets, and renames the file to <path> on finish().
 #include <array>
+#include <chrono>
+#include <optional>
+#include <utility>
 #include <filesystem>
 #include <string>
 #include <unordered_map>
@@ -75,6 +78,13 @@ struct SessionWriter::Impl {
   h5::Group ensure_group(hid_t parent, const char* name, const std::string& where);
   void require_open(const char* action) const;
   [[noreturn]] void fail_write(const std::string& action, const h5::Failure& failure);
+  // The HDF5 side of write_truth / write_truth_set (a live recording defers them to finish()).
+  void store_truth(const SessionTruth& truth);
+  void store_truth_set(std::uint64_t set_index, const TruthSet& truth);
+  void flush_if_due();
+  // Live recordings: reopens the closed file without SWMR, marks it complete and writes the
+  // truth held back while recording.
+  void complete_live_file();
 
   // Declaration order matters: members are destroyed in reverse, so every dataset is closed,
   // then the file, and only then does `partial` delete the file if it was not finished.
@@ -95,6 +105,11 @@ struct SessionWriter::Impl {
 
   bool truth_written = false;
   std::unordered_set<std::uint64_t> truth_sets;
+  // Live recordings cannot create objects once SWMR writing has started, so truth waits here.
+  std::optional<SessionTruth> deferred_truth;
+  std::vector<std::pair<std::uint64_t, TruthSet>> deferred_truth_sets;
+  std::uint64_t sets_at_last_flush = 0;
+  std::chrono::steady_clock::time_point last_flush = std::chrono::steady_clock::now();
   std::uint64_t sets = 0;
   bool finished = false;
   bool failed = false;
@@ -112,6 +127,10 @@ SessionWriter::Impl::Impl(const fs::path& path, const SessionInfo& info, const S
   // file open (and unflushed) until the last object closes; it catches handle leaks in finish().
   h5::PropertyList fapl(h5::check(H5Pcreate(H5P_FILE_ACCESS), "cannot create", "a file access list"));
   h5::check(H5Pset_fclose_degree(fapl.get(), H5F_CLOSE_SEMI), "cannot configure", "a file access list");
+  // SWMR needs the newest file format (HDF5 >= 1.10 reads it; so do h5py and MATLAB R2021b+).
+  if (options.live)
+    h5::check(H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_LATEST, H5F_LIBVER_LATEST), "cannot configure",
+              "a file access list");
   const hid_t id = H5Fcreate(partial.path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get());
   if (id < 0)
     throw bad_input(fmt::format("cannot create session file '{}' (is folder '{}' writable?): {}",
@@ -125,6 +144,13 @@ SessionWriter::Impl::Impl(const fs::path& path, const SessionInfo& info, const S
   } catch (const h5::Failure& failure) {
     throw runtime_error(fmt::format("cannot create the layout of session '{}': {}", partial.path().string(),
                                     failure.what()));
+  }
+  if (options.live) {
+    if (H5Fstart_swmr_write(file.get()) < 0)
+      throw runtime_error(fmt::format("cannot start live (SWMR) writing of session '{}': {}", partial.path().string(),
+                                      h5::error_stack_text()));
+    // From here on the file is worth keeping whatever happens to this writer.
+    partial.release();
   }
   const std::size_t n = streams.size();
   frames_.resize(2 * n);
@@ -142,6 +168,7 @@ void SessionWriter::Impl::create_layout(const SessionInfo& info) {
   h5::write_string_attr(root, layout::kAttrCreatedUtc,
                         info.created_utc.empty() ? utc_now_iso8601() : info.created_utc, "/");
   h5::write_string_attr(root, layout::kAttrCompression, to_string(options.compression), "/");
+  if (options.live) h5::write_int_attr(root, layout::kAttrRecordingComplete, 0, H5T_STD_I32LE, "/");
   h5::write_string_dataset(root, layout::kConfig, info.rig_config_toml, "/config");
 
   h5::Group cameras = h5::create_group(root, layout::kCameras, "/cameras");
@@ -257,14 +284,15 @@ void SessionWriter::Impl::collect(const FrameSet& set) {
   }
 }
 
+// Order matters for readers of a live file and after a crash: the frames go first, then the
+// per-set records, and /sets/trigger_index last, so a set counts (the shortest dataset decides)
+// only once everything about it is on disk.
 void SessionWriter::Impl::write_collected(const FrameSet& set) {
   const hsize_t index = sets;
   const hsize_t n = sets + 1;
-  for (auto& s : streams) s.frames.grow_to(n);
-  for (auto* d : {&trigger_index, &trigger_timestamp, &dt, &frame_timestamp, &frame_present}) d->grow_to(n);
-
-  for (std::size_t c = 0; c < streams.size(); ++c) {
-    CameraStream& s = streams[c];
+  for (CameraStream& s : streams) {
+    s.frames.grow_to(n);
+    const std::size_t c = static_cast<std::size_t>(&s - streams.data());
     for (hsize_t e = 0; e < 2; ++e) {
       const Frame* frame = frames_[2 * c + e];
       if (frame == nullptr) continue;  // missing: its chunk is never allocated (reads as 0)
@@ -279,12 +307,28 @@ void SessionWriter::Impl::write_collected(const FrameSet& set) {
       s.frames.write(offset, s.count, s.mem_type, data);
     }
   }
-  trigger_index.write_record(index, H5T_NATIVE_UINT64, &set.trigger_index);
-  trigger_timestamp.write_record(index, H5T_NATIVE_INT64, &set.trigger_timestamp_ns);
-  dt.write_record(index, H5T_NATIVE_INT64, &set.dt_ns);
+  frame_timestamp.grow_to(n);
   frame_timestamp.write_record(index, H5T_NATIVE_INT64, timestamps_.data());
+  frame_present.grow_to(n);
   frame_present.write_record(index, H5T_NATIVE_UINT8, present_.data());
+  dt.grow_to(n);
+  dt.write_record(index, H5T_NATIVE_INT64, &set.dt_ns);
+  trigger_timestamp.grow_to(n);
+  trigger_timestamp.write_record(index, H5T_NATIVE_INT64, &set.trigger_timestamp_ns);
+  trigger_index.grow_to(n);
+  trigger_index.write_record(index, H5T_NATIVE_UINT64, &set.trigger_index);
   sets = n;
+  if (options.live) flush_if_due();
+}
+
+void SessionWriter::Impl::flush_if_due() {
+  const auto now = std::chrono::steady_clock::now();
+  const bool by_count = options.flush.every_sets > 0 && sets - sets_at_last_flush >= options.flush.every_sets;
+  const bool by_time = std::chrono::duration<double>(now - last_flush).count() >= options.flush.every_seconds;
+  if (!by_count && !by_time) return;
+  h5::check(H5Fflush(file.get(), H5F_SCOPE_LOCAL), "cannot flush", partial.path().string());
+  sets_at_last_flush = sets;
+  last_flush = now;
 }
 
 // /truth and its children are created on first use: write_truth and write_truth_set may be
@@ -325,60 +369,88 @@ void SessionWriter::write_truth(const SessionTruth& truth) {
     if (!seen.insert(c.id).second)
       throw bad_input(fmt::format("session '{}': truth camera id '{}' appears twice", m.final_path.string(), c.id));
   }
-  try {
-    h5::Group group = m.ensure_group(m.file.get(), layout::kTruth, "/truth");
-    h5::write_string_attr(group.get(), layout::kAttrCase, truth.case_name, "/truth");
-    h5::write_string_attr(group.get(), layout::kAttrFlow, truth.flow_name, "/truth");
-    h5::write_string_attr(group.get(), layout::kAttrFlowParameters, truth.flow_parameters, "/truth");
-    h5::write_uint64_attr(group.get(), layout::kAttrSeed, truth.seed, "/truth");
-    h5::write_double_attr(group.get(), layout::kAttrPpp, truth.ppp, "/truth");
-
-    h5::Group cameras = m.ensure_group(group.get(), layout::kCameras, "/truth/cameras");
-    std::vector<std::string> order;
-    for (const auto& c : truth.cameras) order.push_back(c.id);
-    h5::write_string_list_attr(cameras.get(), layout::kAttrOrder, order, "/truth/cameras");
-    const hsize_t mat_dims[2] = {3, 3};
-    const hsize_t vec_dims[1] = {3};
-    for (const auto& c : truth.cameras) {
-      const std::string where = "/truth/cameras/" + c.id;
-      h5::Group g = h5::create_group(cameras.get(), c.id.c_str(), where);
-      h5::write_string_attr(g.get(), layout::kAttrModel, c.model, where);
-      h5::write_doubles_attr(g.get(), layout::kAttrK, c.K, mat_dims, where);
-      h5::write_doubles_attr(g.get(), layout::kAttrR, c.R, mat_dims, where);
-      const std::array<double, 3> t{c.t.x, c.t.y, c.t.z};
-      h5::write_doubles_attr(g.get(), layout::kAttrT, t, vec_dims, where);
-      h5::write_int_attr(g.get(), layout::kAttrWidth, c.width, H5T_STD_I32LE, where);
-      h5::write_int_attr(g.get(), layout::kAttrHeight, c.height, H5T_STD_I32LE, where);
+  if (m.options.live) {
+    m.deferred_truth = truth;
+  } else {
+    try {
+      m.store_truth(truth);
+    } catch (const h5::Failure& failure) {
+      m.fail_write("writing truth to", failure);
     }
-  } catch (const h5::Failure& failure) {
-    m.fail_write("writing truth to", failure);
   }
   m.truth_written = true;
 }
 
+void SessionWriter::Impl::store_truth(const SessionTruth& truth) {
+  h5::Group group = ensure_group(file.get(), layout::kTruth, "/truth");
+  h5::write_string_attr(group.get(), layout::kAttrCase, truth.case_name, "/truth");
+  h5::write_string_attr(group.get(), layout::kAttrFlow, truth.flow_name, "/truth");
+  h5::write_string_attr(group.get(), layout::kAttrFlowParameters, truth.flow_parameters, "/truth");
+  h5::write_uint64_attr(group.get(), layout::kAttrSeed, truth.seed, "/truth");
+  h5::write_double_attr(group.get(), layout::kAttrPpp, truth.ppp, "/truth");
+
+  h5::Group cameras = ensure_group(group.get(), layout::kCameras, "/truth/cameras");
+  std::vector<std::string> order;
+  for (const auto& c : truth.cameras) order.push_back(c.id);
+  h5::write_string_list_attr(cameras.get(), layout::kAttrOrder, order, "/truth/cameras");
+  const hsize_t mat_dims[2] = {3, 3};
+  const hsize_t vec_dims[1] = {3};
+  for (const auto& c : truth.cameras) {
+    const std::string where = "/truth/cameras/" + c.id;
+    h5::Group g = h5::create_group(cameras.get(), c.id.c_str(), where);
+    h5::write_string_attr(g.get(), layout::kAttrModel, c.model, where);
+    h5::write_doubles_attr(g.get(), layout::kAttrK, c.K, mat_dims, where);
+    h5::write_doubles_attr(g.get(), layout::kAttrR, c.R, mat_dims, where);
+    const std::array<double, 3> t{c.t.x, c.t.y, c.t.z};
+    h5::write_doubles_attr(g.get(), layout::kAttrT, t, vec_dims, where);
+    h5::write_int_attr(g.get(), layout::kAttrWidth, c.width, H5T_STD_I32LE, where);
+    h5::write_int_attr(g.get(), layout::kAttrHeight, c.height, H5T_STD_I32LE, where);
+  }
+}
+
 void SessionWriter::write_truth_set(std::uint64_t set_index, const TruthSet& truth) {
-  static_assert(sizeof(Vec3d) == 3 * sizeof(double), "Vec3d is written as 3 packed doubles");
   h5::silence_errors();
   Impl& m = *impl_;
   m.require_open("write truth");
   if (m.truth_sets.contains(set_index))
     throw runtime_error(fmt::format("truth for set {} of session '{}' is already written", set_index,
                                     m.final_path.string()));
-  try {
-    h5::Group truth_group = m.ensure_group(m.file.get(), layout::kTruth, "/truth");
-    h5::Group sets = m.ensure_group(truth_group.get(), layout::kSets, "/truth/sets");
-    const std::string where = layout::truth_set_path(set_index);
-    h5::Group g = h5::create_group(sets.get(), layout::truth_set_name(set_index).c_str(), where);
-    for (const auto& [name, particles] : {std::pair{layout::kParticlesA, &truth.particles_a},
-                                          std::pair{layout::kParticlesB, &truth.particles_b}}) {
-      const hsize_t dims[2] = {particles->size(), 3};
-      h5::write_dataset(g.get(), name, H5T_IEEE_F64LE, dims, H5T_NATIVE_DOUBLE, particles->data(),
-                        where + "/" + name);
+  if (m.options.live) {
+    m.deferred_truth_sets.emplace_back(set_index, truth);
+  } else {
+    try {
+      m.store_truth_set(set_index, truth);
+    } catch (const h5::Failure& failure) {
+      m.fail_write("writing truth to", failure);
     }
-  } catch (const h5::Failure& failure) {
-    m.fail_write("writing truth to", failure);
   }
   m.truth_sets.insert(set_index);
+}
+
+void SessionWriter::Impl::store_truth_set(std::uint64_t set_index, const TruthSet& truth) {
+  static_assert(sizeof(Vec3d) == 3 * sizeof(double), "Vec3d is written as 3 packed doubles");
+  h5::Group truth_group = ensure_group(file.get(), layout::kTruth, "/truth");
+  h5::Group sets_group = ensure_group(truth_group.get(), layout::kSets, "/truth/sets");
+  const std::string where = layout::truth_set_path(set_index);
+  h5::Group g = h5::create_group(sets_group.get(), layout::truth_set_name(set_index).c_str(), where);
+  for (const auto& [name, particles] : {std::pair{layout::kParticlesA, &truth.particles_a},
+                                        std::pair{layout::kParticlesB, &truth.particles_b}}) {
+    const hsize_t dims[2] = {particles->size(), 3};
+    h5::write_dataset(g.get(), name, H5T_IEEE_F64LE, dims, H5T_NATIVE_DOUBLE, particles->data(), where + "/" + name);
+  }
+}
+
+void SessionWriter::Impl::complete_live_file() {
+  h5::PropertyList fapl(h5::check(H5Pcreate(H5P_FILE_ACCESS), "cannot create", "a file access list"));
+  h5::check(H5Pset_fclose_degree(fapl.get(), H5F_CLOSE_SEMI), "cannot configure", "a file access list");
+  file = h5::File(h5::check(H5Fopen(partial.path().c_str(), H5F_ACC_RDWR, fapl.get()), "cannot reopen",
+                            partial.path().string()));
+  h5::check(H5Adelete(file.get(), layout::kAttrRecordingComplete), "cannot update", "/recording_complete");
+  h5::write_int_attr(file.get(), layout::kAttrRecordingComplete, 1, H5T_STD_I32LE, "/");
+  if (deferred_truth) store_truth(*deferred_truth);
+  for (const auto& [index, truth] : deferred_truth_sets) store_truth_set(index, truth);
+  deferred_truth.reset();
+  deferred_truth_sets.clear();
 }
 
 void SessionWriter::finish() {
@@ -391,6 +463,18 @@ void SessionWriter::finish() {
   for (auto* d : {&m.trigger_index, &m.trigger_timestamp, &m.dt, &m.frame_timestamp, &m.frame_present})
     closed &= d->close() >= 0;
   closed &= m.file.close() >= 0;  // flushes everything to disk
+  if (closed && m.options.live) {
+    // The live file is kept under its .partial name from here until the rename below.
+    try {
+      m.complete_live_file();
+      closed = m.file.close() >= 0;
+    } catch (const h5::Failure& failure) {
+      m.failed = true;
+      throw runtime_error(fmt::format("completing live session '{}' failed; the recorded sets remain readable in "
+                                      "it: {}",
+                                      partial, failure.what()));
+    }
+  }
   if (!closed) {
     m.failed = true;
     throw runtime_error(fmt::format("closing session '{}' failed, so it may be incomplete (is the disk full?): {}",

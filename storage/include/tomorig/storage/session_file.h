@@ -78,9 +78,24 @@ struct SetRecord {
 
 // SessionInfo::software_version and created_utc are filled in by the writer when empty;
 // SessionInfo::compression is ignored on writing (the options decide).
+// When a live recording makes its sets visible and durable (HDF5 flush): after `every_sets`
+// sets or `every_seconds` since the last flush, whichever comes first. A flush costs a few
+// metadata writes; after a crash or SIGKILL, every set before the last flush is intact.
+struct FlushPolicy {
+  std::uint64_t every_sets = 10;
+  double every_seconds = 1.0;
+};
+
 struct SessionWriterOptions {
   Compression compression = Compression::none;
   bool overwrite = false;  // replace an existing file at the final path
+  // Live recording (the recorder of a running rig): the file is written with HDF5 SWMR, so
+  // `tomorig inspect <path>.partial` reads it while it grows, it is flushed by `flush`, and a
+  // writer abandoned without finish() (a full disk, Ctrl-C, a crash) keeps "<path>.partial"
+  // with every set written so far instead of deleting it. Truth is held in memory and written
+  // by finish(). Without `live`, an unfinished file is deleted: nothing half-written remains.
+  bool live = false;
+  FlushPolicy flush;
 };
 
 class SessionWriter {
@@ -134,6 +149,9 @@ class SessionReader {
   SetRecord set_record(std::uint64_t set_index) const;
   int missing_frames() const;     // over the whole session
   int incomplete_sets() const;
+  // False for a live recording still being written, or one that was interrupted (its
+  // "<name>.partial" file): then set_count() is the sets that were completely written.
+  bool recording_complete() const;
   bool has_truth() const;
   SessionTruth truth() const;                              // bad_input if !has_truth()
   bool has_truth_set(std::uint64_t set_index) const;

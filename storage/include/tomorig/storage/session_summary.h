@@ -28,6 +28,9 @@ struct SessionSummary {
   double time_span_s = 0.0;  // last - first trigger timestamp
   std::uint64_t first_trigger_index = 0, last_trigger_index = 0;
 
+  // False while a live recording is written or after it was interrupted (a .partial file).
+  bool recording_complete = true;
+
   bool truth = false;  // a simulated session with ground truth
   std::string truth_case, truth_flow;
   std::uint64_t truth_sets = 0;

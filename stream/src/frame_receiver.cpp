@@ -1,0 +1,50 @@
+#include "tomorig/stream/frame_receiver.h"
+
+#include "multipart.h"
+#include "socket_setup.h"
+#include "tomorig/core/error.h"
+#include "tomorig/stream/wire_format.h"
+
+namespace tomorig::stream {
+
+struct FrameReceiver::Impl {
+  detail::OpenedSocket opened;
+  ReceiverStats stats;
+  std::optional<std::uint64_t> last_index;
+};
+
+FrameReceiver::FrameReceiver(zmq::context_t& context, SocketOptions options)
+    : impl_(std::make_unique<Impl>(
+          Impl{detail::open_socket(context, zmq::socket_type::pull, options, std::chrono::milliseconds(0)), {}, {}})) {}
+
+FrameReceiver::~FrameReceiver() = default;
+
+std::optional<FrameSet> FrameReceiver::receive() {
+  auto parts = detail::receive_multipart(impl_->opened.socket);
+  if (!parts) {
+    ++impl_->stats.timeouts;
+    return std::nullopt;
+  }
+  std::uint64_t bytes = 0;
+  for (const auto& p : *parts) bytes += p.size();
+  FrameSet set;
+  try {
+    set = decode_frame_set(std::move(*parts));
+  } catch (const Error&) {
+    ++impl_->stats.rejected_messages;
+    throw;
+  }
+  // A replay loop restarting at 0 is not a loss; only forward jumps are.
+  if (impl_->last_index && set.set_index > *impl_->last_index + 1)
+    impl_->stats.sets_missing += set.set_index - *impl_->last_index - 1;
+  impl_->last_index = set.set_index;
+  ++impl_->stats.sets_received;
+  impl_->stats.bytes_received += bytes;
+  return set;
+}
+
+const std::string& FrameReceiver::endpoint() const { return impl_->opened.endpoint; }
+
+ReceiverStats FrameReceiver::stats() const { return impl_->stats; }
+
+}  // namespace tomorig::stream

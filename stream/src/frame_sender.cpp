@@ -1,0 +1,64 @@
+#include "tomorig/stream/frame_sender.h"
+
+#include <fmt/format.h>
+
+#include "socket_setup.h"
+#include "tomorig/core/error.h"
+#include "tomorig/stream/wire_format.h"
+
+namespace tomorig::stream {
+
+struct FrameSender::Impl {
+  detail::OpenedSocket opened;
+  std::atomic<std::uint64_t> sets_sent{0};
+  std::atomic<std::uint64_t> bytes_sent{0};
+  std::atomic<std::uint64_t> blocked_sends{0};
+  std::atomic<std::uint64_t> timed_out_sends{0};
+};
+
+FrameSender::FrameSender(zmq::context_t& context, SocketOptions options)
+    : impl_(std::make_unique<Impl>()) {
+  // Closing waits up to one timeout so sets already queued still reach the receiver.
+  impl_->opened = detail::open_socket(context, zmq::socket_type::push, options, options.timeout);
+}
+
+FrameSender::~FrameSender() = default;
+
+bool FrameSender::send(const FrameSet& set) {
+  std::vector<zmq::message_t> parts = encode_frame_set(set);
+  std::uint64_t bytes = 0;
+  for (const auto& p : parts) bytes += p.size();
+  zmq::socket_t& socket = impl_->opened.socket;
+  const auto flags_for = [&](std::size_t i) {
+    return i + 1 < parts.size() ? zmq::send_flags::sndmore : zmq::send_flags::none;
+  };
+
+  // The first part decides: ZeroMQ admits or refuses a whole message at its first part, so
+  // once it is in, the rest follows without waiting.
+  if (!socket.send(parts[0], flags_for(0) | zmq::send_flags::dontwait)) {
+    impl_->blocked_sends.fetch_add(1);
+    impl_->blocked_sends.notify_all();
+    if (!socket.send(parts[0], flags_for(0))) {  // waits up to the send timeout
+      impl_->timed_out_sends.fetch_add(1);
+      return false;
+    }
+  }
+  for (std::size_t i = 1; i < parts.size(); ++i)
+    if (!socket.send(parts[i], flags_for(i)))
+      throw runtime_error(fmt::format("set {} was cut off after part {} of {} on {}; the stream is out of step",
+                                      set.set_index, i, parts.size(), impl_->opened.endpoint));
+  impl_->sets_sent.fetch_add(1);
+  impl_->bytes_sent.fetch_add(bytes);
+  return true;
+}
+
+const std::string& FrameSender::endpoint() const { return impl_->opened.endpoint; }
+
+SenderStats FrameSender::stats() const {
+  return {impl_->sets_sent.load(), impl_->bytes_sent.load(), impl_->blocked_sends.load(),
+          impl_->timed_out_sends.load()};
+}
+
+void FrameSender::await_blocked_send(std::uint64_t seen) const { impl_->blocked_sends.wait(seen); }
+
+}  // namespace tomorig::stream
