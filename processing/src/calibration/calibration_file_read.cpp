@@ -1,0 +1,219 @@
+// Reading the calibration file: every value is checked, and a problem names the camera and
+// the key, so that a hand-edited or truncated file is refused before it can mis-project.
+#include <cmath>
+#include <string>
+
+#include <fmt/core.h>
+#include <toml++/toml.h>
+
+#include "tomorig/core/error.h"
+#include "tomorig/processing/calibration/calibration_file.h"
+#include "tomorig/processing/calibration/dlt_camera.h"
+#include "tomorig/processing/calibration/pinhole_camera.h"
+#include "tomorig/processing/calibration/polynomial_camera.h"
+#include "tomorig/processing/calibration/two_plane_camera.h"
+
+namespace tomorig::calibration {
+namespace {
+
+// Reads values of one camera's tables, naming "<file>: camera <id>: <key>" in every error.
+class CameraReader {
+ public:
+  explicit CameraReader(std::string where) : where_(std::move(where)) {}
+
+  [[noreturn]] void fail(const std::string& key, const std::string& problem) const {
+    throw bad_input(fmt::format("{}: {} {}", where_, key, problem));
+  }
+
+  const toml::table& table(const toml::table& parent, const std::string& prefix, const char* key) const {
+    const toml::table* t = parent[key].as_table();
+    if (!t) fail(prefix + key, "is missing (or is not a table)");
+    return *t;
+  }
+
+  double number(const toml::table& t, const std::string& prefix, const char* key) const {
+    return number_of(t[key].node(), prefix + key);
+  }
+
+  std::int64_t integer(const toml::table& t, const std::string& prefix, const char* key) const {
+    const auto v = t[key].value<std::int64_t>();
+    if (!t[key].is_integer() || !v) fail(prefix + key, t[key] ? "must be an integer" : "is missing");
+    return *v;
+  }
+
+  bool boolean(const toml::table& t, const std::string& prefix, const char* key) const {
+    const auto v = t[key].value<bool>();
+    if (!v) fail(prefix + key, t[key] ? "must be true or false" : "is missing");
+    return *v;
+  }
+
+  std::string string(const toml::table& t, const std::string& prefix, const char* key) const {
+    const auto v = t[key].value<std::string>();
+    if (!v) fail(prefix + key, t[key] ? "must be a string" : "is missing");
+    return *v;
+  }
+
+  // An array of exactly `size` finite numbers (size < 0: any length >= 1).
+  std::vector<double> numbers(const toml::table& t, const std::string& prefix, const char* key, int size) const {
+    const std::string name = prefix + key;
+    const toml::array* a = t[key].as_array();
+    if (!a) fail(name, t[key] ? "must be an array of numbers" : "is missing");
+    if (size >= 0 && static_cast<int>(a->size()) != size)
+      fail(name, fmt::format("has {} values, expected {}", a->size(), size));
+    std::vector<double> out;
+    for (std::size_t k = 0; k < a->size(); ++k) out.push_back(number_of(a->get(k), fmt::format("{}[{}]", name, k)));
+    return out;
+  }
+
+ private:
+  double number_of(const toml::node* node, const std::string& name) const {
+    if (!node) fail(name, "is missing");
+    if (!node->is_number()) fail(name, "must be a number");
+    const double v = node->value<double>().value_or(std::nan(""));
+    if (!std::isfinite(v)) fail(name, fmt::format("is {}: every coefficient must be finite", v));
+    return v;
+  }
+
+  std::string where_;
+};
+
+Normalization read_normalization(const CameraReader& r, const toml::table& cam) {
+  const toml::table& t = r.table(cam, "", "normalization");
+  const std::string p = "normalization.";
+  Normalization n;
+  const auto wc = r.numbers(t, p, "world_centre", 3);
+  const auto ic = r.numbers(t, p, "image_centre", 2);
+  n.world_centre = {wc[0], wc[1], wc[2]};
+  n.image_centre = {ic[0], ic[1]};
+  n.world_scale = r.number(t, p, "world_scale");
+  n.image_scale = r.number(t, p, "image_scale");
+  if (!(n.world_scale > 0)) r.fail(p + "world_scale", "must be > 0");
+  if (!(n.image_scale > 0)) r.fail(p + "image_scale", "must be > 0");
+  return n;
+}
+
+FitReport read_report(const CameraReader& r, const toml::table& cam, const std::string& model, int id) {
+  const toml::table& t = r.table(cam, "", "fit");
+  const std::string p = "fit.";
+  FitReport rep;
+  rep.model = model;
+  rep.camera = fmt::format("camera {}", id);
+  rep.points = static_cast<int>(r.integer(t, p, "points"));
+  rep.planes = static_cast<int>(r.integer(t, p, "planes"));
+  rep.forward_mean_px = r.number(t, p, "forward_mean_px");
+  rep.forward_max_px = r.number(t, p, "forward_max_px");
+  rep.reverse_mean_um = r.number(t, p, "reverse_mean_um");
+  rep.reverse_max_um = r.number(t, p, "reverse_max_um");
+  if (t.contains("inverse_mapping_mean_um")) rep.inverse_mapping_mean_um = r.number(t, p, "inverse_mapping_mean_um");
+  rep.iterations = static_cast<int>(r.integer(t, p, "iterations"));
+  rep.converged = r.boolean(t, p, "converged");
+  return rep;
+}
+
+int newton_steps(const CameraReader& r, const toml::table& c, const std::string& p) {
+  const auto steps = r.integer(c, p, "newton_steps");
+  if (steps < 0 || steps > 50) r.fail(p + "newton_steps", fmt::format("= {} must be in [0, 50]", steps));
+  return static_cast<int>(steps);
+}
+
+// Builds a model from values already read; a constructor's complaint (e.g. R is not a
+// rotation) still names the camera.
+template <typename Make>
+std::shared_ptr<const CameraModel> construct(const CameraReader& r, Make make) {
+  try {
+    return make();
+  } catch (const Error& e) {
+    r.fail("coefficients", fmt::format("are invalid: {}", e.what()));
+  }
+}
+
+std::shared_ptr<const CameraModel> read_model(const CameraReader& r, const toml::table& cam, const std::string& model,
+                                              const Normalization& n) {
+  const toml::table& c = r.table(cam, "", "coefficients");
+  const std::string p = "coefficients.";
+  if (model == "pinhole") {
+    PinholeParameters pp;
+    pp.fx = r.number(c, p, "fx");
+    pp.fy = r.number(c, p, "fy");
+    pp.cx = r.number(c, p, "cx");
+    pp.cy = r.number(c, p, "cy");
+    const auto R = r.numbers(c, p, "R", 9);
+    const auto t = r.numbers(c, p, "t", 3);
+    std::copy(R.begin(), R.end(), pp.R.begin());
+    pp.t = {t[0], t[1], t[2]};
+    return construct(r, [&] { return std::make_shared<PinholeCamera>(pp); });
+  }
+  if (model == "dlt") {
+    const auto a = r.numbers(c, p, "matrix", 12);
+    Mat34d m;
+    std::copy(a.begin(), a.end(), m.begin());
+    return construct(r, [&] { return std::make_shared<DltCamera>(m, n); });
+  }
+  if (model == "rational2" || model == "soloff3") {
+    const PolynomialKind kind = model == "rational2" ? PolynomialKind::rational2 : PolynomialKind::soloff3;
+    const int count = PolynomialCamera::coefficient_count(kind);
+    auto forward = r.numbers(c, p, "forward", count);
+    auto inverse = r.numbers(c, p, "inverse", count);
+    const int steps = newton_steps(r, c, p);
+    return construct(r, [&] { return std::make_shared<PolynomialCamera>(kind, n, forward, inverse, steps); });
+  }
+  if (model == "twoplane") {
+    const toml::array* planes = c["planes"].as_array();
+    if (!planes || planes->size() < 2) r.fail(p + "planes", "must be an array of at least 2 plane tables");
+    std::vector<TwoPlaneMapping> mappings;
+    for (std::size_t k = 0; k < planes->size(); ++k) {
+      const toml::table* t = planes->get(k)->as_table();
+      const std::string pk = fmt::format("{}planes[{}].", p, k);
+      if (!t) r.fail(pk.substr(0, pk.size() - 1), "must be a table");
+      mappings.push_back({r.number(*t, pk, "z"), r.numbers(*t, pk, "to_world", TwoPlaneCamera::kCoefficientsPerMapping),
+                          r.numbers(*t, pk, "to_image", TwoPlaneCamera::kCoefficientsPerMapping)});
+    }
+    const int steps = newton_steps(r, c, p);
+    return construct(r, [&] { return std::make_shared<TwoPlaneCamera>(n, mappings, steps); });
+  }
+  r.fail("model", fmt::format("= \"{}\" is not a known model (pinhole, dlt, twoplane, rational2, soloff3)", model));
+}
+
+}  // namespace
+
+std::vector<CameraCalibration> load_calibration(const std::filesystem::path& path) {
+  toml::table root;
+  try {
+    root = toml::parse_file(path.string());
+  } catch (const toml::parse_error& e) {
+    if (!std::filesystem::exists(path))
+      throw bad_input(fmt::format("calibration file {} does not exist", path.string()));
+    throw bad_input(fmt::format("calibration file {}: line {}: {}", path.string(), e.source().begin.line,
+                                e.description()));
+  }
+  const std::string file = path.string();
+  if (root["format"].value<std::string>() != "tomorig-calibration")
+    throw bad_input(fmt::format("{}: not a tomorig calibration file (format = \"tomorig-calibration\" is missing)", file));
+  if (root["version"].value<std::int64_t>() != 1)
+    throw bad_input(fmt::format("{}: unsupported version (this tomorig reads version = 1)", file));
+  const toml::array* cameras = root["camera"].as_array();
+  if (!cameras || cameras->empty()) throw bad_input(fmt::format("{}: no [[camera]] entries", file));
+
+  std::vector<CameraCalibration> out;
+  for (std::size_t k = 0; k < cameras->size(); ++k) {
+    const toml::table* cam = cameras->get(k)->as_table();
+    if (!cam) throw bad_input(fmt::format("{}: camera entry {} is not a table", file, k));
+    const CameraReader entry(fmt::format("{}: camera entry {}", file, k));
+    CameraCalibration c;
+    c.id = static_cast<int>(entry.integer(*cam, "", "id"));
+    for (const auto& seen : out)
+      if (seen.id == c.id) entry.fail("id", fmt::format("= {} is used by two cameras", c.id));
+    const CameraReader r(fmt::format("{}: camera {}", file, c.id));
+    c.image_size = {static_cast<int>(r.integer(*cam, "", "image_width")), static_cast<int>(r.integer(*cam, "", "image_height"))};
+    if (c.image_size.width <= 0 || c.image_size.height <= 0) r.fail("image_width/image_height", "must be > 0");
+    const std::string model = r.string(*cam, "", "model");
+    const Normalization n = read_normalization(r, *cam);
+    c.model = read_model(r, *cam, model, n);
+    c.report = read_report(r, *cam, model, c.id);
+    c.report.normalization = n;
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+}  // namespace tomorig::calibration
