@@ -14,5 +14,6 @@ void add_import_command(CLI::App& root);    // cmd_import.cpp
 void add_run_command(CLI::App& root);       // cmd_run.cpp: the main job on a rig config
 void add_trigger_command(CLI::App& root);   // cmd_trigger.cpp: trigger plan
 void add_reconstruct_command(CLI::App& root);  // cmd_reconstruct.cpp
+void add_bench_command(CLI::App& root);     // cmd_bench.cpp: bench stream | record | recon
 
 }  // namespace tomorig::app

@@ -23,6 +23,8 @@ int main(int argc, char** argv) {
   add_import_command(app);
   add_inspect_command(app);
   add_config_command(app);
+  add_bench_command(app);
+  add_trigger_command(app);
 
   try {
     app.parse(argc, argv);

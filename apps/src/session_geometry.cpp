@@ -8,6 +8,7 @@
 
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
+#include "tomorig/processing/calibration/calibration_file.h"
 #include "tomorig/processing/calibration/pinhole_camera.h"
 
 namespace tomorig::app {
@@ -56,9 +57,49 @@ SessionCameras truth_cameras(const storage::SessionReader& session) {
     p.cy = match->K[5];
     p.R = match->R;
     p.t = match->t;
-    out.models.push_back(std::make_unique<calibration::PinholeCamera>(p));
+    out.models.push_back(std::make_shared<calibration::PinholeCamera>(p));
   }
   return out;
+}
+
+SessionCameras calibration_cameras(const storage::SessionReader& session, const std::filesystem::path& file) {
+  const std::vector<calibration::CameraCalibration> cal = calibration::load_calibration(file);
+  const auto& cams = session.info().cameras;
+  if (cal.size() != cams.size())
+    throw bad_input(fmt::format("calibration file '{}' has {} cameras but session '{}' has {}; use the calibration "
+                                "of this rig",
+                                file.string(), cal.size(), session.path().string(), cams.size()));
+  SessionCameras out;
+  out.source = file.string();
+  out.models.resize(cams.size());
+  for (const auto& c : cal) {
+    if (c.id < 0 || static_cast<std::size_t>(c.id) >= cams.size() || out.models[static_cast<std::size_t>(c.id)])
+      throw bad_input(fmt::format("calibration file '{}': camera {} is not one of cameras 0 to {} of the session, or "
+                                  "appears twice",
+                                  file.string(), c.id, cams.size() - 1));
+    const auto& cam = cams[static_cast<std::size_t>(c.id)];
+    if (c.image_size.width != cam.width || c.image_size.height != cam.height)
+      throw bad_input(fmt::format("calibration file '{}': camera {} was calibrated on {} x {} images but session "
+                                  "camera {} is {} x {}",
+                                  file.string(), c.id, c.image_size.width, c.image_size.height, cam.id, cam.width,
+                                  cam.height));
+    out.models[static_cast<std::size_t>(c.id)] = c.model;
+  }
+  return out;
+}
+
+SessionCameras session_cameras(const storage::SessionReader& session, const std::string& calib) {
+  if (calib == "truth") return truth_cameras(session);
+  if (!calib.empty()) return calibration_cameras(session, calib);
+  if (session.has_truth()) return truth_cameras(session);
+  const std::string& toml = session.info().rig_config_toml;
+  if (!toml.empty()) {
+    const config::RigConfig rig = config::parse_rig_config(toml, session.path().string() + ":/config");
+    if (rig.calibration_file) return calibration_cameras(session, *rig.calibration_file);
+  }
+  throw bad_input(fmt::format("session '{}' has neither truth cameras nor a calibration file in its rig config; give "
+                              "one with --calib",
+                              session.path().string()));
 }
 
 VoxelGrid grid_from_session(const storage::SessionReader& session) {

@@ -2,6 +2,7 @@
 // What a reconstruction needs from a session besides its pixels: the camera models, in the
 // session's camera order, and the voxel grid. Shared by `reconstruct`, `bench recon` and the
 // back-end pipeline.
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -13,7 +14,7 @@
 namespace tomorig::app {
 
 struct SessionCameras {
-  std::vector<std::unique_ptr<calibration::CameraModel>> models;  // session camera order
+  std::vector<std::shared_ptr<const calibration::CameraModel>> models;  // session camera order
   std::string source;  // "truth of <session>" or the calibration file, for reports
   std::vector<const calibration::CameraModel*> pointers() const;
 };
@@ -22,6 +23,15 @@ struct SessionCameras {
 // (bad_input) if the session has no truth (then a calibration file is needed) or its truth
 // cameras do not match the session's cameras by id and size.
 SessionCameras truth_cameras(const storage::SessionReader& session);
+
+// The models of a calibration file (docs/calibration.md): its camera i is the session's camera
+// i. Throws tomorig::Error (bad_input) if the file is bad, or its camera count or image sizes
+// disagree with the session's, naming the camera.
+SessionCameras calibration_cameras(const storage::SessionReader& session, const std::filesystem::path& file);
+
+// `calib` empty or "truth": truth_cameras (empty falls back to the rig config's calibration
+// file when the session has no truth); otherwise calibration_cameras.
+SessionCameras session_cameras(const storage::SessionReader& session, const std::string& calib);
 
 // The [grid] of the session's rig config, as a VoxelGrid (the config gives the grid centre;
 // VoxelGrid wants the centre of voxel (0, 0, 0)).

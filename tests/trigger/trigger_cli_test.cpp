@@ -1,0 +1,90 @@
+// End to end: `tomorig trigger plan` as an operator runs it.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.h"
+
+namespace tomorig::testing {
+namespace {
+
+// A one-camera rig whose [trigger] table is `trigger_toml`.
+std::string rig_with_trigger(const std::string& trigger_toml) {
+  return "name = \"trigger test rig\"\n"
+         "[[cameras]]\nid = \"cam0\"\nbackend = \"simulated\"\n"
+         "[cameras.roi]\nwidth = 64\nheight = 64\n" +
+         trigger_toml;
+}
+
+std::string write(const TempDir& dir, const std::string& name, const std::string& text) {
+  const auto path = dir / name;
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+TEST(TriggerCli, PlanOnTheDefaultRigPrintsEveryChannel) {
+  const CliResult r = run_tomorig("trigger plan");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* text : {"laser", "cameras", "frame A", "frame B", "pulse 1", "dt 100 us", "feasible"})
+    EXPECT_NE(r.out.find(text), std::string::npos) << text << " in:\n" << r.out;
+}
+
+TEST(TriggerCli, JsonParsesAndHoldsThePlan) {
+  const CliResult r = run_tomorig("trigger plan --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("dt_us").get<double>(), 100.0);
+  EXPECT_EQ(j.at("rate_hz").get<double>(), 10.0);
+  ASSERT_EQ(j.at("channels").size(), 2u);
+  // Pulse 1 inside frame A, pulse 2 inside frame B, as printed.
+  const auto& a = j.at("frame_a");
+  const auto& p1 = j.at("light_pulse_1");
+  EXPECT_LE(a.at("rise_us").get<double>(), p1.at("rise_us").get<double>());
+  EXPECT_LE(p1.at("fall_us").get<double>(), a.at("fall_us").get<double>());
+  EXPECT_EQ(j.at("device").at("name"), "simulated");
+}
+
+TEST(TriggerCli, GpioRigWithMicrosecondDtExits2) {
+  TempDir dir;
+  const std::string rig = write(dir, "gpio.toml", rig_with_trigger(R"(
+[trigger]
+backend = "gpio"
+rate_hz = 10.0
+dt_us = 100.0
+[[trigger.channels]]
+name = "laser"
+role = "light"
+chip = "gpiochip0"
+line = 17
+[[trigger.channels]]
+name = "cam"
+role = "camera"
+chip = "gpiochip0"
+line = 18
+)"));
+  const CliResult r = run_tomorig("trigger plan --config '" + rig + "'");
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.err.find("dt 100 us is below the gpio device's time resolution of 1000 us"), std::string::npos) << r.err;
+}
+
+TEST(TriggerCli, InfeasibleTimingExits2) {
+  TempDir dir;
+  // 5 kHz: a 200 µs period cannot hold the camera's 1 ms frame B.
+  const std::string rig = write(dir, "fast.toml", rig_with_trigger("[trigger]\nbackend = \"simulated\"\nrate_hz = 5000.0\n"));
+  const CliResult r = run_tomorig("trigger plan --config '" + rig + "' --json");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  EXPECT_NE(r.err.find("longer than the period 200 us"), std::string::npos) << r.err;
+}
+
+TEST(TriggerCli, MissingConfigExits2) {
+  const CliResult r = run_tomorig("trigger plan --config /nonexistent/rig.toml");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("/nonexistent/rig.toml"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace tomorig::testing
