@@ -8,12 +8,14 @@ namespace tomorig::app {
 
 void add_bench_stream_command(CLI::App& bench);  // bench_stream.cpp
 void add_bench_record_command(CLI::App& bench);  // bench_record.cpp
+void add_bench_recon_command(CLI::App& bench);   // bench_recon.cpp
 
 void add_bench_command(CLI::App& root) {
   CLI::App* bench = root.add_subcommand("bench", "Measure speed and accuracy on simulated cases; print JSON");
   bench->require_subcommand(1);
   add_bench_stream_command(*bench);
   add_bench_record_command(*bench);
+  add_bench_recon_command(*bench);
 }
 
 }  // namespace tomorig::app

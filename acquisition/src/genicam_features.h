@@ -1,0 +1,23 @@
+#pragma once
+// Setting GenICam features by name with errors that name the camera and the feature.
+#include <arv.h>
+
+#include <string>
+#include <vector>
+
+namespace tomorig::acquisition::detail {
+
+// Whether the camera's GenICam description has an implemented feature of this name.
+bool has_feature(ArvDevice* device, const std::string& feature);
+
+// Sets `feature` to `value` (an enumeration entry, a number, a boolean or a string).
+// Throws bad_input "camera <camera_id>: ..." naming the feature when the camera lacks it,
+// an enumeration does not offer the value (listing what it offers), or the camera refuses or
+// changes the value.
+void set_feature(ArvDevice* device, const std::string& camera_id, const std::string& feature,
+                 const std::string& value);
+
+// Entries an enumeration feature currently offers (empty if it is not an enumeration).
+std::vector<std::string> enumeration_entries(ArvDevice* device, const std::string& feature);
+
+}  // namespace tomorig::acquisition::detail

@@ -1,0 +1,154 @@
+#include "grid_projector.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/core.h>
+
+#include "tomorig/core/error.h"
+
+namespace tomorig::recon::detail {
+namespace {
+
+constexpr int kCoarsestStep = 16;
+// Where a projection is undefined (behind the camera): far outside every image.
+constexpr float kNowhere = -1.0e6f;
+
+int cells_along(int n, int step) { return std::max(1, (n - 1 + step - 1) / step); }
+
+Vec2d project_or_nowhere(const calibration::CameraModel& model, const Vec3d& world) {
+  const Vec2d p = model.project(world);
+  if (!std::isfinite(p.x) || !std::isfinite(p.y)) return {kNowhere, kNowhere};
+  return p;
+}
+
+// Samples voxel indices 0, s, 2s, ... and always the last one, so the corners are included.
+std::vector<int> sample_indices(int n) {
+  const int s = std::max(1, n / 32);
+  std::vector<int> out;
+  for (int i = 0; i < n; i += s) out.push_back(i);
+  if (out.back() != n - 1) out.push_back(n - 1);
+  return out;
+}
+
+}  // namespace
+
+GridProjector::GridProjector(const PreparedInput& in, double tolerance_px) : grid_(in.grid) {
+  for (std::size_t c = 0; c < in.camera_count(); ++c) {
+    const calibration::CameraModel& model = *in.cameras[c];
+    const CameraImage& image = in.images[c];
+
+    // A grid that this camera does not see leaves nothing to reconstruct: refuse it.
+    bool seen = false;
+    const std::vector<int> is = sample_indices(grid_.nx), js = sample_indices(grid_.ny), ks = sample_indices(grid_.nz);
+    for (int k : ks)
+      for (int j : js)
+        for (int i : is) {
+          const Vec2d p = project_or_nowhere(model, grid_.centre_of(i, j, k));
+          seen = seen || (p.x >= -0.5 && p.x <= image.width - 0.5 && p.y >= -0.5 && p.y <= image.height - 0.5);
+        }
+    if (!seen)
+      throw bad_input(fmt::format("reconstruction: camera {} sees none of the grid ({} x {} x {} voxels of {} mm "
+                                  "from origin ({}, {}, {}) mm): check the grid position and the calibration",
+                                  c, grid_.nx, grid_.ny, grid_.nz, grid_.voxel_size, grid_.origin.x, grid_.origin.y,
+                                  grid_.origin.z));
+
+    Lattice lattice;
+    for (int step = kCoarsestStep; step >= 2; step /= 2) {
+      lattice = build(model, step, in.threads);
+      lattice.max_error = measure_error(lattice, in.threads);
+      if (lattice.max_error <= tolerance_px) break;
+    }
+    if (lattice.max_error > tolerance_px) {  // exact projection of every voxel
+      lattice = {};
+      lattice.step = 1;
+    }
+    lattice.model = &model;
+    cams_.push_back(std::move(lattice));
+  }
+}
+
+GridProjector::Lattice GridProjector::build(const calibration::CameraModel& model, int step, int threads) const {
+  Lattice l;
+  l.model = &model;
+  l.step = step;
+  l.nodes_x = cells_along(grid_.nx, step) + 1;
+  l.nodes_y = cells_along(grid_.ny, step) + 1;
+  l.nodes_z = cells_along(grid_.nz, step) + 1;
+  const std::size_t count = static_cast<std::size_t>(l.nodes_x) * l.nodes_y * l.nodes_z;
+  l.u.resize(count);
+  l.v.resize(count);
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
+  for (int c = 0; c < l.nodes_z; ++c)
+    for (int b = 0; b < l.nodes_y; ++b)
+      for (int a = 0; a < l.nodes_x; ++a) {
+        const Vec2d p = project_or_nowhere(model, grid_.centre_of(a * step, b * step, c * step));
+        const std::size_t n = static_cast<std::size_t>(a) + l.nodes_x * (static_cast<std::size_t>(b) + l.nodes_y * c);
+        l.u[n] = static_cast<float>(p.x);
+        l.v[n] = static_cast<float>(p.y);
+      }
+  return l;
+}
+
+double GridProjector::measure_error(const Lattice& l, int threads) const {
+  double worst = 0;
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) reduction(max : worst)
+  for (int c = 0; c < l.nodes_z - 1; ++c)
+    for (int b = 0; b < l.nodes_y - 1; ++b)
+      for (int a = 0; a < l.nodes_x - 1; ++a) {
+        auto node = [&](int da, int db, int dc) {
+          return static_cast<std::size_t>(a + da) + l.nodes_x * (static_cast<std::size_t>(b + db) + l.nodes_y * (c + dc));
+        };
+        double u = 0, v = 0;
+        bool defined = true;
+        for (int d = 0; d < 8; ++d) {
+          const std::size_t n = node(d & 1, (d >> 1) & 1, d >> 2);
+          defined = defined && l.u[n] != kNowhere;
+          u += 0.125 * l.u[n];
+          v += 0.125 * l.v[n];
+        }
+        if (!defined) continue;  // behind the camera: never sampled inside an image
+        const double h = 0.5 * l.step;
+        const Vec2d p = l.model->project(grid_.centre_of(a * l.step + h, b * l.step + h, c * l.step + h));
+        const double err = std::hypot(p.x - u, p.y - v);
+        if (std::isfinite(p.x) && std::isfinite(p.y)) worst = std::max(worst, err);
+      }
+  return worst;
+}
+
+void GridProjector::row(std::size_t c, int j, int k, float* u, float* v) const {
+  const Lattice& l = cams_[c];
+  if (l.step == 1) {
+    for (int i = 0; i < grid_.nx; ++i) {
+      const Vec2d p = project_or_nowhere(*l.model, grid_.centre_of(i, j, k));
+      u[i] = static_cast<float>(p.x);
+      v[i] = static_cast<float>(p.y);
+    }
+    return;
+  }
+  const int s = l.step;
+  const int cb = std::min(j / s, l.nodes_y - 2), cc = std::min(k / s, l.nodes_z - 2);
+  const float fb = static_cast<float>(j - cb * s) / s, fc = static_cast<float>(k - cc * s) / s;
+  const float w00 = (1 - fb) * (1 - fc), w10 = fb * (1 - fc), w01 = (1 - fb) * fc, w11 = fb * fc;
+  const std::size_t plane = static_cast<std::size_t>(l.nodes_x) * l.nodes_y;
+  const std::size_t r00 = static_cast<std::size_t>(l.nodes_x) * cb + plane * cc;
+  const std::size_t r10 = r00 + l.nodes_x, r01 = r00 + plane, r11 = r00 + plane + l.nodes_x;
+  float prev_u = 0, prev_v = 0;
+  for (int a = 0; a < l.nodes_x; ++a) {
+    // Bilinear in (j, k) at this lattice column, then linear along the row to the next one.
+    const float nu = w00 * l.u[r00 + a] + w10 * l.u[r10 + a] + w01 * l.u[r01 + a] + w11 * l.u[r11 + a];
+    const float nv = w00 * l.v[r00 + a] + w10 * l.v[r10 + a] + w01 * l.v[r01 + a] + w11 * l.v[r11 + a];
+    if (a > 0) {
+      const int i0 = (a - 1) * s, i1 = a == l.nodes_x - 1 ? grid_.nx : std::min(a * s, grid_.nx);
+      const float du = (nu - prev_u) / s, dv = (nv - prev_v) / s;
+      for (int i = i0; i < i1; ++i) {
+        u[i] = prev_u + du * (i - i0);
+        v[i] = prev_v + dv * (i - i0);
+      }
+    }
+    prev_u = nu;
+    prev_v = nv;
+  }
+}
+
+}  // namespace tomorig::recon::detail

@@ -1,0 +1,45 @@
+#pragma once
+// Image positions of voxel centres, for any CameraModel, without a virtual call per voxel.
+//
+// Per camera, the model's project() is evaluated exactly on a coarse 3-D lattice of voxel
+// centres (every `step` voxels along each axis) and interpolated trilinearly in between. The
+// interpolation error is measured at the centre of every lattice cell against the exact
+// projection; if it exceeds the tolerance the lattice is refined, down to step 2, and below
+// that every voxel is projected exactly. So a pinhole camera (smooth, nearly affine over a few
+// voxels) uses a coarse lattice, and a strongly distorting model still gets the right answer.
+#include <cstddef>
+#include <vector>
+
+#include "prepared_input.h"
+
+namespace tomorig::recon::detail {
+
+class GridProjector {
+ public:
+  // Throws tomorig::Error (bad_input) if some camera sees none of the grid.
+  explicit GridProjector(const PreparedInput& in, double tolerance_px = 0.01);
+
+  // Pixel positions (u, v) in camera c of voxels (0 .. nx-1, j, k).
+  void row(std::size_t c, int j, int k, float* u, float* v) const;
+
+  // Lattice step used for camera c; 1 means exact projection of every voxel.
+  int step(std::size_t c) const { return cams_[c].step; }
+  // Largest interpolation error found at the cell centres, pixels (0 for exact projection).
+  double max_error(std::size_t c) const { return cams_[c].max_error; }
+
+ private:
+  struct Lattice {
+    const calibration::CameraModel* model = nullptr;
+    int step = 1;
+    int nodes_x = 0, nodes_y = 0, nodes_z = 0;
+    std::vector<float> u, v;  // nodes_x fastest
+    double max_error = 0.0;
+  };
+  Lattice build(const calibration::CameraModel& model, int step, int threads) const;
+  double measure_error(const Lattice& lattice, int threads) const;
+
+  VoxelGrid grid_;
+  std::vector<Lattice> cams_;
+};
+
+}  // namespace tomorig::recon::detail

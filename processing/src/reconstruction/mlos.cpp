@@ -1,0 +1,172 @@
+#include "mlos.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <exception>
+#include <numeric>
+#include <string>
+
+#include <fmt/core.h>
+
+#include "system_memory.h"
+#include "tomorig/core/error.h"
+
+namespace tomorig::recon::detail {
+namespace {
+
+// A thresholded copy of an image with a one-pixel border of zeros, so that bilinear sampling
+// anywhere inside the image span [-0.5, W - 0.5] needs no bounds checks.
+struct SampledImage {
+  int width = 0, height = 0, stride = 0;
+  std::vector<float> pixels;
+  double nonzero_fraction = 0.0;
+
+  SampledImage(const CameraImage& image, double threshold) : width(image.width), height(image.height) {
+    stride = width + 2;
+    pixels.assign(static_cast<std::size_t>(stride) * (height + 2), 0.0f);
+    const float cut = static_cast<float>(threshold) * image.max;
+    std::size_t nonzero = 0;
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x) {
+        const float v = image.at(x, y);
+        if (v > 0 && v >= cut) {
+          pixels[static_cast<std::size_t>(y + 1) * stride + x + 1] = v;
+          ++nonzero;
+        }
+      }
+    nonzero_fraction = static_cast<double>(nonzero) / (static_cast<double>(width) * height);
+  }
+
+  // Bilinear interpolation at (u, v); 0 outside the image span.
+  float sample(float u, float v) const {
+    if (!(u >= -0.5f && u <= width - 0.5f && v >= -0.5f && v <= height - 0.5f)) return 0.0f;
+    // u, v >= -0.5 here, so truncating u + 1 floors it, without a libm call (baseline x86-64
+    // has no SSE4.1 round instruction, and std::floor is a function call there).
+    const int x = static_cast<int>(u + 1.0f), y = static_cast<int>(v + 1.0f);
+    const float ax = u + 1.0f - static_cast<float>(x), ay = v + 1.0f - static_cast<float>(y);
+    const float* p = pixels.data() + static_cast<std::size_t>(y) * stride + x;
+    const float top = p[0] + ax * (p[1] - p[0]);
+    const float bottom = p[stride] + ax * (p[stride + 1] - p[stride]);
+    return top + ay * (bottom - top);
+  }
+};
+
+struct SliceResult {
+  std::vector<std::uint32_t> index;
+  std::vector<float> value;
+  std::vector<std::vector<float>> u, v;
+};
+
+}  // namespace
+
+ActiveSet run_mlos(const PreparedInput& in, const GridProjector& projector, const MlosSettings& settings) {
+  const VoxelGrid& g = in.grid;
+  const std::size_t cams = in.camera_count();
+  std::vector<SampledImage> images;
+  for (const CameraImage& image : in.images) images.emplace_back(image, settings.threshold);
+  // The most selective camera first: most voxels then stop after one lookup.
+  std::vector<std::size_t> order(cams);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return images[a].nonzero_fraction < images[b].nonzero_fraction;
+  });
+
+  const double limit_mb = settings.memory_limit_mb > 0 ? settings.memory_limit_mb : usable_memory_mb();
+  const double budget_voxels =
+      limit_mb > 0 && settings.bytes_per_voxel > 0
+          ? (limit_mb * 1024.0 * 1024.0 - settings.fixed_bytes) / settings.bytes_per_voxel
+          : 1e300;
+  std::atomic<std::size_t> active{0};
+  std::atomic<bool> over_budget{false};
+
+  std::vector<SliceResult> slices(static_cast<std::size_t>(g.nz));
+#pragma omp parallel num_threads(in.threads)
+  {
+    std::vector<float> u(static_cast<std::size_t>(g.nx) * cams), v(static_cast<std::size_t>(g.nx) * cams);
+    std::vector<float> product(static_cast<std::size_t>(g.nx));
+    std::vector<int> alive(static_cast<std::size_t>(g.nx));
+#pragma omp for schedule(dynamic, 1)
+    for (int k = 0; k < g.nz; ++k) {
+      if (over_budget.load(std::memory_order_relaxed)) continue;
+      SliceResult& out = slices[static_cast<std::size_t>(k)];
+      if (settings.keep_positions) {
+        out.u.resize(cams);
+        out.v.resize(cams);
+      }
+      for (int j = 0; j < g.ny; ++j) {
+        int count = 0;
+        for (std::size_t o = 0; o < cams; ++o) {
+          const std::size_t c = order[o];
+          float* uc = u.data() + c * g.nx;
+          float* vc = v.data() + c * g.nx;
+          projector.row(c, j, k, uc, vc);
+          const SampledImage& image = images[c];
+          if (o == 0) {
+            for (int i = 0; i < g.nx; ++i) {
+              const float s = image.sample(uc[i], vc[i]);
+              product[i] = s;
+              alive[count] = i;
+              count += s > 0.0f;
+            }
+          } else {
+            int kept = 0;
+            for (int n = 0; n < count; ++n) {
+              const int i = alive[n];
+              const float s = image.sample(uc[i], vc[i]);
+              product[i] *= s;
+              alive[kept] = i;
+              kept += s > 0.0f;
+            }
+            count = kept;
+          }
+          if (count == 0) break;
+        }
+        for (int n = 0; n < count; ++n) {
+          const int i = alive[n];
+          out.index.push_back(static_cast<std::uint32_t>(g.linear(i, j, k)));
+          out.value.push_back(product[i]);
+          if (settings.keep_positions)
+            for (std::size_t c = 0; c < cams; ++c) {
+              out.u[c].push_back(u[c * g.nx + i]);
+              out.v[c].push_back(v[c * g.nx + i]);
+            }
+        }
+      }
+      const std::size_t total = active.fetch_add(out.index.size()) + out.index.size();
+      if (static_cast<double>(total) > budget_voxels) over_budget.store(true);
+    }
+  }
+  if (over_budget.load()) {
+    const std::string what = fmt::format("the MLOS support (at least {} active voxels)", active.load());
+    const double bytes = settings.fixed_bytes + settings.bytes_per_voxel * static_cast<double>(active.load());
+    require_memory(bytes, limit_mb, what);
+    throw bad_input(fmt::format("reconstruction: {} needs more than the {:.0f} MB available", what, limit_mb));
+  }
+
+  ActiveSet set;
+  const std::size_t total = active.load();
+  set.index.reserve(total);
+  set.value.reserve(total);
+  if (settings.keep_positions) {
+    set.u.assign(cams, {});
+    set.v.assign(cams, {});
+    for (std::size_t c = 0; c < cams; ++c) {
+      set.u[c].reserve(total);
+      set.v[c].reserve(total);
+    }
+  }
+  for (SliceResult& s : slices) {
+    set.index.insert(set.index.end(), s.index.begin(), s.index.end());
+    set.value.insert(set.value.end(), s.value.begin(), s.value.end());
+    if (settings.keep_positions)
+      for (std::size_t c = 0; c < cams; ++c) {
+        set.u[c].insert(set.u[c].end(), s.u[c].begin(), s.u[c].end());
+        set.v[c].insert(set.v[c].end(), s.v[c].begin(), s.v[c].end());
+      }
+    s = {};  // release as we go: the peak is one copy plus one slice
+  }
+  return set;
+}
+
+}  // namespace tomorig::recon::detail

@@ -1,0 +1,36 @@
+// MLOS as a reconstructor in its own right: the support and its product intensities.
+#include "algorithms.h"
+#include "support.h"
+
+namespace tomorig::recon::detail {
+namespace {
+
+class MlosReconstructor final : public Reconstructor {
+ public:
+  explicit MlosReconstructor(const ReconstructionOptions& options) : options_(options) {}
+  std::string name() const override { return "mlos"; }
+
+  SparseVolume reconstruct(const ReconstructionInput& input, ReconstructionReport& report) override {
+    const auto start = std::chrono::steady_clock::now();
+    report = {};
+    report.algorithm = name();
+    SupportNeeds needs;
+    needs.mlos_threshold = options_.mlos_threshold;
+    needs.positions = false;
+    Support s = build_support(input, options_, needs, report);
+    SparseVolume volume = to_volume(s.in.grid, s.set.index, s.set.value);
+    finish_report(report, start, volume);
+    return volume;
+  }
+
+ private:
+  ReconstructionOptions options_;
+};
+
+}  // namespace
+
+std::unique_ptr<Reconstructor> make_mlos(const ReconstructionOptions& options) {
+  return std::make_unique<MlosReconstructor>(options);
+}
+
+}  // namespace tomorig::recon::detail

@@ -1,0 +1,232 @@
+#include "sparse_system.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <omp.h>
+
+namespace tomorig::recon::detail {
+namespace {
+
+// Bounds on ln(I / I~). A pixel recorded as 0 under a projected voxel would set R = 0 and kill
+// the voxel outright however small its weight there; the floor keeps it a strong but graded
+// penalty. The ceiling stops a voxel whose projection has decayed to ~0 from exploding.
+constexpr float kMinLogRatio = -13.8f;  // R >= 1e-6
+constexpr float kMaxLogRatio = 6.9f;   // R <= 1e3
+// Projected intensities below this carry no information (no live voxel reaches the pixel).
+constexpr float kNoProjection = 1e-12f;
+
+// P = 0 selects the patch size at run time; 3, 4 and 5 are unrolled by the compiler.
+template <int P>
+void scatter(const std::int32_t* offset, const std::uint16_t* row_u, const std::uint16_t* row_v, const float* lut_u,
+             const float* lut_v, const float* e, std::size_t begin, std::size_t end, float* image, int stride,
+             int runtime_patch) {
+  const int p = P ? P : runtime_patch;
+  for (std::size_t n = begin; n < end; ++n) {
+    const float en = e[n];
+    if (en == 0.0f) continue;
+    const float* wu = lut_u + static_cast<std::size_t>(row_u[n]) * p;
+    const float* wv = lut_v + static_cast<std::size_t>(row_v[n]) * p;
+    float* base = image + offset[n];
+    for (int b = 0; b < p; ++b) {
+      const float ev = en * wv[b];
+      float* row = base + static_cast<std::ptrdiff_t>(b) * stride;
+      for (int a = 0; a < p; ++a) row[a] += ev * wu[a];
+    }
+  }
+}
+
+template <int P>
+inline float gather(std::int32_t offset, const float* wu, const float* wv, const float* image, int stride,
+                    int runtime_patch) {
+  const int p = P ? P : runtime_patch;
+  const float* base = image + offset;
+  float s = 0.0f;
+  for (int b = 0; b < p; ++b) {
+    const float* row = base + static_cast<std::ptrdiff_t>(b) * stride;
+    float r = 0.0f;
+    for (int a = 0; a < p; ++a) r += wu[a] * row[a];
+    s += wv[b] * r;
+  }
+  return s;
+}
+
+template <int P>
+double update_kernel(const std::int32_t* offset, const std::uint16_t* row_u, const std::uint16_t* row_v,
+                     const float* lut_u, const float* lut_v, const float* log_ratio, int stride, std::size_t voxels,
+                     float* e, float mu, int threads, int runtime_patch) {
+  const int p = P ? P : runtime_patch;
+  double sum = 0.0;
+  const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(voxels);
+#pragma omp parallel for num_threads(threads) schedule(static) reduction(+ : sum)
+  for (std::ptrdiff_t n = 0; n < count; ++n) {
+    if (e[n] == 0.0f) continue;
+    const float s = gather<P>(offset[n], lut_u + static_cast<std::size_t>(row_u[n]) * p,
+                              lut_v + static_cast<std::size_t>(row_v[n]) * p, log_ratio, stride, p);
+    const float factor = std::exp(mu * s);
+    e[n] *= factor;
+    sum += std::fabs(1.0f - factor);
+  }
+  return sum;
+}
+
+template <int P>
+void accumulate_kernel(const std::int32_t* offset, const std::uint16_t* row_u, const std::uint16_t* row_v,
+                       const float* lut_u, const float* lut_v, const float* log_ratio, int stride,
+                       std::size_t voxels, float* acc, int threads, int runtime_patch) {
+  const int p = P ? P : runtime_patch;
+  const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(voxels);
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (std::ptrdiff_t n = 0; n < count; ++n)
+    acc[n] += gather<P>(offset[n], lut_u + static_cast<std::size_t>(row_u[n]) * p,
+                        lut_v + static_cast<std::size_t>(row_v[n]) * p, log_ratio, stride, p);
+}
+
+}  // namespace
+
+SparseSystem::SparseSystem(const PreparedInput& in, const ActiveSet& set, int patch, int lut_steps)
+    : patch_(patch), voxels_(set.size()) {
+  const VoxelGrid& g = in.grid;
+  const std::size_t plane = static_cast<std::size_t>(g.nx) * g.ny;
+  std::size_t largest_image = 0;
+  for (std::size_t c = 0; c < in.camera_count(); ++c) {
+    Camera cam;
+    const CameraImage& image = in.images[c];
+    cam.width = image.width;
+    cam.height = image.height;
+    cam.pad = patch + 1;
+    cam.stride = cam.width + 2 * cam.pad;
+    const std::size_t size = static_cast<std::size_t>(cam.stride) * (cam.height + 2 * cam.pad);
+    largest_image = std::max(largest_image, size);
+    cam.measured.assign(size, 0.0f);
+    for (int y = 0; y < cam.height; ++y)
+      std::copy_n(image.pixels.data() + static_cast<std::size_t>(y) * cam.width, cam.width,
+                  cam.measured.data() + static_cast<std::size_t>(y + cam.pad) * cam.stride + cam.pad);
+    cam.projection.assign(size, 0.0f);
+    cam.log_ratio.assign(size, 0.0f);
+
+    std::vector<double> sigma_u(g.nz), sigma_v(g.nz);
+    for (int k = 0; k < g.nz; ++k) {
+      const PsfSample s = in.psf[c].at(g.origin.z + k * g.voxel_size);
+      sigma_u[k] = s.sigma_u_px;
+      sigma_v[k] = s.sigma_v_px;
+    }
+    cam.u_weights = AxisWeights(sigma_u, patch, lut_steps);
+    cam.v_weights = AxisWeights(sigma_v, patch, lut_steps);
+
+    cam.offset.resize(voxels_);
+    cam.row_u.resize(voxels_);
+    cam.row_v.resize(voxels_);
+    const float* u = set.u[c].data();
+    const float* v = set.v[c].data();
+    const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(voxels_);
+#pragma omp parallel for num_threads(in.threads) schedule(static)
+    for (std::ptrdiff_t n = 0; n < count; ++n) {
+      const int k = static_cast<int>(set.index[n] / plane);
+      int su = 0, sv = 0;
+      cam.u_weights.locate(u[n], k, su, cam.row_u[n]);
+      cam.v_weights.locate(v[n], k, sv, cam.row_v[n]);
+      // Active voxels image inside every camera, so this clamp never moves one; it only
+      // guarantees that no patch can reach outside the padded image.
+      su = std::clamp(su, -cam.pad, cam.width + cam.pad - patch);
+      sv = std::clamp(sv, -cam.pad, cam.height + cam.pad - patch);
+      cam.offset[n] = (sv + cam.pad) * cam.stride + su + cam.pad;
+    }
+    cams_.push_back(std::move(cam));
+  }
+  scratch_.resize(static_cast<std::size_t>(std::max(0, in.threads - 1)), std::vector<float>(largest_image, 0.0f));
+}
+
+double SparseSystem::estimate_bytes(const PreparedInput& in, std::size_t voxels, int patch, int threads) {
+  const double cams = static_cast<double>(in.camera_count());
+  // index + intensity + SMART accumulator + MLOS value, and per camera: offset, two LUT rows
+  // and the float (u, v) MLOS hands over.
+  const double per_voxel = 16.0 + cams * (8.0 + 8.0);
+  return per_voxel * static_cast<double>(voxels) + image_bytes(in, 3, patch + 1) +
+         image_bytes(in, 1, patch + 1) / cams * std::max(0, threads - 1);
+}
+
+bool SparseSystem::inside(std::size_t c, std::int32_t pixel) const {
+  const Camera& cam = cams_[c];
+  const int y = pixel / cam.stride - cam.pad, x = pixel % cam.stride - cam.pad;
+  return x >= 0 && x < cam.width && y >= 0 && y < cam.height;
+}
+
+PixelResidual SparseSystem::project(std::size_t c, const float* e, int threads) {
+  Camera& cam = cams_[c];
+  const std::size_t size = cam.measured.size();
+  const int rows = cam.height + 2 * cam.pad;
+  const int team = std::max(1, std::min(threads, static_cast<int>(scratch_.size()) + 1));
+  double abs_difference = 0.0, measured = 0.0;
+#pragma omp parallel num_threads(team)
+  {
+    // Each thread scatters a contiguous block of voxels into its own image (no atomics);
+    // the images are then summed row by row, and the log ratio computed in the same pass.
+    const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+    float* image = t == 0 ? cam.projection.data() : scratch_[t - 1].data();
+    std::fill(image, image + size, 0.0f);
+    const std::size_t begin = voxels_ * t / nt, end = voxels_ * (t + 1) / nt;
+    const float* lu = cam.u_weights.table();
+    const float* lv = cam.v_weights.table();
+    switch (patch_) {
+      case 3: scatter<3>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, e, begin, end, image, cam.stride, patch_); break;
+      case 4: scatter<4>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, e, begin, end, image, cam.stride, patch_); break;
+      case 5: scatter<5>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, e, begin, end, image, cam.stride, patch_); break;
+      default: scatter<0>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, e, begin, end, image, cam.stride, patch_); break;
+    }
+#pragma omp barrier
+#pragma omp for schedule(static) reduction(+ : abs_difference, measured)
+    for (int y = 0; y < rows; ++y) {
+      float* proj = cam.projection.data() + static_cast<std::size_t>(y) * cam.stride;
+      for (int s = 1; s < nt; ++s) {
+        const float* other = scratch_[s - 1].data() + static_cast<std::size_t>(y) * cam.stride;
+#pragma omp simd
+        for (int x = 0; x < cam.stride; ++x) proj[x] += other[x];
+      }
+      const int iy = y - cam.pad;
+      if (iy < 0 || iy >= cam.height) continue;  // padding: log ratio stays 0
+      const float* meas = cam.measured.data() + static_cast<std::size_t>(y) * cam.stride + cam.pad;
+      float* lr = cam.log_ratio.data() + static_cast<std::size_t>(y) * cam.stride + cam.pad;
+      const float* pr = proj + cam.pad;
+      float row_diff = 0.0f, row_meas = 0.0f;
+      for (int x = 0; x < cam.width; ++x) {
+        const float i_meas = meas[x], i_proj = pr[x];
+        row_diff += std::fabs(i_meas - i_proj);
+        row_meas += i_meas;
+        float l = 0.0f;
+        if (i_proj > kNoProjection)
+          l = i_meas > 0.0f ? std::clamp(std::log(i_meas / i_proj), kMinLogRatio, kMaxLogRatio) : kMinLogRatio;
+        lr[x] = l;
+      }
+      abs_difference += row_diff;
+      measured += row_meas;
+    }
+  }
+  return {abs_difference, measured};
+}
+
+double SparseSystem::update(std::size_t c, float* e, float mu, int threads) const {
+  const Camera& cam = cams_[c];
+  const float* lu = cam.u_weights.table();
+  const float* lv = cam.v_weights.table();
+  switch (patch_) {
+    case 3: return update_kernel<3>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, cam.log_ratio.data(), cam.stride, voxels_, e, mu, threads, patch_);
+    case 4: return update_kernel<4>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, cam.log_ratio.data(), cam.stride, voxels_, e, mu, threads, patch_);
+    case 5: return update_kernel<5>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, cam.log_ratio.data(), cam.stride, voxels_, e, mu, threads, patch_);
+    default: return update_kernel<0>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, cam.log_ratio.data(), cam.stride, voxels_, e, mu, threads, patch_);
+  }
+}
+
+void SparseSystem::accumulate(std::size_t c, float* acc, int threads) const {
+  const Camera& cam = cams_[c];
+  const float* lu = cam.u_weights.table();
+  const float* lv = cam.v_weights.table();
+  switch (patch_) {
+    case 3: accumulate_kernel<3>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, cam.log_ratio.data(), cam.stride, voxels_, acc, threads, patch_); break;
+    case 4: accumulate_kernel<4>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, cam.log_ratio.data(), cam.stride, voxels_, acc, threads, patch_); break;
+    case 5: accumulate_kernel<5>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, cam.log_ratio.data(), cam.stride, voxels_, acc, threads, patch_); break;
+    default: accumulate_kernel<0>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, cam.log_ratio.data(), cam.stride, voxels_, acc, threads, patch_); break;
+  }
+}
+
+}  // namespace tomorig::recon::detail

@@ -1,0 +1,42 @@
+#pragma once
+// The common first half of every reconstructor: check and convert the input, set up the
+// projections, check memory up front, run MLOS. And the common last steps: the sparse volume
+// and the report's totals.
+#include <chrono>
+
+#include "active_set.h"
+#include "grid_projector.h"
+#include "prepared_input.h"
+#include "tomorig/processing/reconstruction/reconstructor.h"
+
+namespace tomorig::recon::detail {
+
+struct Support {
+  PreparedInput in;
+  ActiveSet set;
+  int patch = 3;  // p of the sparse system
+};
+
+// What the caller will keep per active voxel after MLOS (for the memory checks), and whether
+// it needs the voxels' image positions.
+struct SupportNeeds {
+  double mlos_threshold = 0.05;
+  bool positions = true;
+  double extra_bytes_per_voxel = 0.0;  // beyond the sparse system's own
+};
+
+// Throws tomorig::Error (bad_input) as prepare_input, GridProjector and run_mlos do, and if the
+// estimated memory exceeds the limit.
+Support build_support(const ReconstructionInput& input, const ReconstructionOptions& options, const SupportNeeds& needs,
+                      ReconstructionReport& report);
+
+// The voxels of `set` whose intensity is > 0, as a sparse volume.
+SparseVolume to_volume(const VoxelGrid& grid, const std::vector<std::uint32_t>& index, const std::vector<float>& e);
+
+// Fills the totals of the report (time since `start`, peak RSS, non-zero voxels).
+void finish_report(ReconstructionReport& report, std::chrono::steady_clock::time_point start,
+                   const SparseVolume& volume);
+
+double seconds_since(std::chrono::steady_clock::time_point start);
+
+}  // namespace tomorig::recon::detail
