@@ -12,6 +12,8 @@ void add_simulate_command(CLI::App& root);  // cmd_simulate.cpp
 void add_inspect_command(CLI::App& root);   // cmd_inspect.cpp
 void add_import_command(CLI::App& root);    // cmd_import.cpp
 void add_run_command(CLI::App& root);       // cmd_run.cpp: the main job on a rig config
+void add_replay_command(CLI::App& root);   // cmd_replay.cpp
+void add_record_command(CLI::App& root);   // cmd_record.cpp
 void add_trigger_command(CLI::App& root);   // cmd_trigger.cpp: trigger plan
 void add_reconstruct_command(CLI::App& root);  // cmd_reconstruct.cpp
 void add_bench_command(CLI::App& root);     // cmd_bench.cpp: bench stream | record | recon

@@ -19,6 +19,8 @@ int main(int argc, char** argv) {
   app.footer("Exit codes: 0 ok, 1 runtime failure, 2 bad usage or bad input.\n"
              "Run 'tomorig <command> --help' for a command's options.");
   add_run_command(app);
+  add_replay_command(app);
+  add_record_command(app);
   add_simulate_command(app);
   add_import_command(app);
   add_inspect_command(app);

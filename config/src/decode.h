@@ -21,4 +21,14 @@ void decode_grid(TableReader& root, GridConfig& grid);                          
 void decode_processing(TableReader& root, ProcessingConfig& processing);         // [processing]
 void decode_simulation(TableReader& root, std::optional<SimulationConfig>& sim);  // [simulation]
 
+// Parts of [trigger], called by decode_trigger() in this order.
+void decode_camera_timing(TableReader& trigger, CameraTimingConfig& camera);  // [trigger.camera]
+// [[trigger.light_sources]]; `trigger` holds the already-decoded pulse width (every source's
+// default) and dt (`dt_ok`: usable for the cross-check).
+void decode_light_sources(TableReader& trigger, const TriggerConfig& t, bool dt_ok,
+                          std::vector<LightSourceConfig>& sources);
+// [[trigger.channels]]; light sources must be decoded first (channels name them).
+void decode_trigger_channels(TableReader& trigger, bool gpio, const std::vector<LightSourceConfig>& sources,
+                             std::vector<TriggerChannel>& channels);
+
 }  // namespace tomorig::config::detail

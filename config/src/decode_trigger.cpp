@@ -1,10 +1,7 @@
-#include <map>
-#include <string>
-#include <utility>
-
 #include <fmt/format.h>
 
 #include "decode.h"
+#include "duration_rules.h"
 
 namespace tomorig::config::detail {
 namespace {
@@ -12,45 +9,21 @@ namespace {
 constexpr Choice<TriggerBackend> kTriggerBackends[] = {
     {"gpio", TriggerBackend::gpio}, {"simulated", TriggerBackend::simulated}};
 
-void decode_channel(TableReader& r, bool gpio, TriggerChannel& channel) {
-  r.read("name", channel.name, Need::required, not_empty());
-  r.read("role", channel.role, Need::required, one_of<std::string>({"light", "camera"}));
-  // Only the GPIO backend drives real lines; the simulated device just names its channels.
-  const Need wiring = gpio ? Need::required : Need::optional;
-  r.read("chip", channel.chip, wiring, not_empty());
-  r.read("line", channel.line, wiring, at_least(0));
-  r.report_unknown_keys();
-}
-
-void decode_channels(TableReader& trigger, bool gpio, std::vector<TriggerChannel>& channels) {
-  struct FirstUse {
-    std::string path;
-    int line;
-  };
-  std::map<std::string, FirstUse> names;
-  std::map<std::pair<std::string, int>, FirstUse> wires;
-  // A GPIO trigger without a channel would pulse nothing.
-  for (auto& r : trigger.array_of_tables("channels", gpio ? Need::required : Need::optional)) {
-    TriggerChannel channel;
-    decode_channel(r, gpio, channel);
-    if (!channel.name.empty()) {
-      auto [it, inserted] = names.try_emplace(channel.name, FirstUse{r.path(), r.line_of("name")});
-      if (!inserted)
-        r.issue("name", fmt::format("\"{}\" is already used by {} (line {}); channel names must be unique",
-                                    channel.name, it->second.path, it->second.line));
-    }
-    // Two channels on one GPIO line would fight over it.
-    if (!channel.chip.empty() && channel.line >= 0) {
-      auto [it, inserted] = wires.try_emplace({channel.chip, channel.line}, FirstUse{r.path(), r.line_of("line")});
-      if (!inserted)
-        r.issue("line", fmt::format("{} line {} is already used by {} (line {}); each channel needs its own line",
-                                    channel.chip, channel.line, it->second.path, it->second.line));
-    }
-    channels.push_back(std::move(channel));
-  }
-}
+// Userspace GPIO edges wait for the scheduler: even a PREEMPT_RT kernel has worst-case
+// wake-up latencies of tens of µs, so a finer resolution would be a promise the gpio device
+// cannot keep (it would then accept µs pulses it cannot time).
+constexpr double kFinestGpioResolutionUs = 100.0;
 
 }  // namespace
+
+void decode_camera_timing(TableReader& trigger, CameraTimingConfig& camera) {
+  auto r = trigger.table("camera");
+  if (!r) return;
+  r->read("exposure_a_us", camera.exposure_a_us, Need::optional, positive_duration_us());
+  r->read("interframe_us", camera.interframe_us, Need::optional, at_least(0.0));
+  r->read("exposure_b_us", camera.exposure_b_us, Need::optional, positive_duration_us());
+  r->report_unknown_keys();
+}
 
 void decode_trigger(TableReader& root, TriggerConfig& t) {
   auto r = root.table("trigger");
@@ -65,10 +38,17 @@ void decode_trigger(TableReader& root, TriggerConfig& t) {
   const bool width_ok =
       valid_or_absent(*r, "pulse_width_us", r->read("pulse_width_us", t.pulse_width_us, Need::optional, greater_than(0.0)));
   r->read("jitter_ns", t.jitter_ns, Need::optional, at_least(0.0));
+  r->read("gpio_resolution_us", t.gpio_resolution_us, Need::optional,
+          Rule<double>{[](const double& v) -> std::optional<std::string> {
+            if (v >= kFinestGpioResolutionUs) return std::nullopt;
+            return fmt::format("must be >= {} (a userspace GPIO edge cannot be timed finer, even on PREEMPT_RT; "
+                               "add a pulse_generator channel for us timing)",
+                               kFinestGpioResolutionUs);
+          }});
 
   // Frame straddling: both pulses of an event fit inside one trigger period, and the first
-  // pulse ends before the second starts. Detailed feasibility (camera interframing time,
-  // laser limits) is the trigger module's job.
+  // pulse ends before the second starts. Detailed feasibility (camera interframe time, safety
+  // limits) is the trigger module's job (`tomorig trigger plan`).
   if (rate_ok && dt_ok) {
     const double period_us = 1e6 / t.rate_hz;
     if (t.dt_us >= period_us)
@@ -77,7 +57,9 @@ void decode_trigger(TableReader& root, TriggerConfig& t) {
   if (dt_ok && width_ok && t.pulse_width_us >= t.dt_us)
     r->issue("pulse_width_us", fmt::format("{} must be < dt_us ({})", t.pulse_width_us, t.dt_us));
 
-  decode_channels(*r, backend_known && backend == TriggerBackend::gpio, t.channels);
+  decode_camera_timing(*r, t.camera);
+  decode_light_sources(*r, t, dt_ok, t.light_sources);
+  decode_trigger_channels(*r, backend_known && backend == TriggerBackend::gpio, t.light_sources, t.channels);
   r->report_unknown_keys();
 }
 

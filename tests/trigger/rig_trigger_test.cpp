@@ -19,7 +19,7 @@ TEST(RigTrigger, DefaultRigMapsEveryChannel) {
   EXPECT_EQ(t.inputs.channels[1].role, ChannelRole::camera);
   ASSERT_EQ(t.inputs.light_sources.size(), 1u);
   EXPECT_EQ(t.inputs.light_sources[0].pulse_width_ns, 10);
-  EXPECT_EQ(t.inputs.light_sources[0].kind, LightSourceKind::unknown);  // config has no kind yet
+  EXPECT_EQ(t.inputs.light_sources[0].kind, LightSourceKind::laser);
   const TimingPlan plan = plan_and_check(t);
   EXPECT_EQ(plan.dt_ns, 100'000);
   // And a device made from it arms with that plan.

@@ -35,19 +35,47 @@ struct CameraConfig {
   double distance_mm = 263.16;
 };
 
+// A light source the trigger fires ([[trigger.light_sources]]). Its safety limits are
+// enforced by the trigger device; unset limits take the trigger module's built-in defaults
+// for the kind (docs/trigger.md).
+struct LightSourceConfig {
+  std::string name;                 // unique, e.g. "laser1", "led_cam0"
+  std::string kind;                 // "laser" | "led"; empty: not stated (strictest limits of every kind)
+  double pulse_width_us = 0.01;     // optical pulse width; default: trigger.pulse_width_us
+  double flashlamp_lead_us = 0.0;   // lasers: flash lamp -> Q-switch delay
+  std::optional<double> max_pulse_width_us;  // safety limits; see docs/configuration.md for bounds
+  std::optional<double> max_duty_cycle;
+  std::optional<double> max_rate_hz;
+};
+
 struct TriggerChannel {
-  std::string name;      // e.g. "laser1", "cam_trigger"
-  std::string role;      // "light" | "camera"
-  std::string chip;      // GPIO chip for the gpio backend, e.g. "gpiochip0"
-  int line = -1;         // GPIO line offset
+  std::string name;           // e.g. "laser1", "cam_trigger"
+  std::string role;           // "light" | "camera" | "flashlamp" | "pulse_generator"
+  std::string light_source;   // light and flashlamp channels: a LightSourceConfig::name; empty:
+                              // (light, no [[trigger.light_sources]]) the channel is its own source
+  std::string pulses = "both";  // light and flashlamp channels: "first" | "second" | "both"
+  double delay_us = 0.0;      // edge -> effect: camera latency, LED rise time, Q-switch build-up
+  std::optional<double> width_us;  // electrical pulse width; unset: the trigger module's default
+  std::string chip;           // GPIO chip for the gpio backend, e.g. "gpiochip0"
+  int line = -1;              // GPIO line offset
+};
+
+// The double-frame camera timing ([trigger.camera]); all cameras alike.
+struct CameraTimingConfig {
+  double exposure_a_us = 20.0;    // frame A exposure
+  double interframe_us = 0.12;    // blind time between frames A and B
+  double exposure_b_us = 1000.0;  // frame B (until frame A is read out)
 };
 
 struct TriggerConfig {
   TriggerBackend backend = TriggerBackend::simulated;
   double rate_hz = 10.0;          // repetition rate of double-frame events
   double dt_us = 100.0;           // pulse separation
-  double pulse_width_us = 0.01;   // light pulse width
+  double pulse_width_us = 0.01;   // light pulse width (default of every light source)
   double jitter_ns = 0.0;         // simulated backend: timing jitter (1 sigma)
+  double gpio_resolution_us = 1000.0;  // gpio backend: time resolution of a userspace GPIO edge
+  CameraTimingConfig camera;
+  std::vector<LightSourceConfig> light_sources;
   std::vector<TriggerChannel> channels;
 };
 

@@ -1,8 +1,9 @@
 #pragma once
-// From the rig configuration to timing inputs and a device. The [trigger] table holds the
-// rate, dt, one pulse width and the channels; what it does not (yet) hold - camera exposure
-// and interframe time, light-source kinds and limits, channel delays - takes the defaults of
-// TimingInputs / default_limits() (docs/trigger.md lists them).
+// From the rig configuration to timing inputs and a device. Every input comes from the
+// [trigger] table (docs/configuration.md): rate, dt, camera timing ([trigger.camera]), light
+// sources with kinds and safety limits ([[trigger.light_sources]]), channel roles, delays and
+// widths, GPIO wiring and resolution. Keys left out take the defaults of TimingInputs /
+// default_limits() (docs/trigger.md lists them).
 #include <memory>
 #include <vector>
 
@@ -23,9 +24,12 @@ struct RigTrigger {
   DeviceCapabilities capabilities() const;
 };
 
-// Each light channel becomes its own light source (named after the channel, kind unknown, so
-// the strictest built-in limits apply) making both pulses; camera channels trigger cameras. A
-// simulated rig without channels gets one camera channel "cameras" and one light channel "light".
+// Light sources carry their configured kind and limits (unset limits: the kind's built-in
+// defaults; no kind: the strictest). A light channel of a rig without [[trigger.light_sources]]
+// is its own source (named after the channel, kind unknown, width trigger.pulse_width_us).
+// Wired channels of the gpio backend default to a width of the GPIO resolution. A simulated rig
+// without channels gets one camera channel "cameras" and one light channel "light" (firing the
+// one declared light source, if exactly one is declared).
 RigTrigger rig_trigger(const config::RigConfig& rig);
 
 // Plans and checks everything a device would check at arm(): timing, safety limits, device

@@ -1,0 +1,177 @@
+// tomorig replay: publishes a recorded session's FrameSets on the lossless stream (PUSH), as
+// an acquisition process would, so that a recorder or a processing back end can be run and
+// tested without a rig. Replay binds by default and the receiver (tomorig record) connects.
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+#include <zmq.hpp>
+
+#include "commands.h"
+#include "replay_schedule.h"
+#include "stop_signal.h"
+#include "tomorig/core/error.h"
+#include "tomorig/storage/session_file.h"
+#include "tomorig/stream/frame_sender.h"
+
+namespace tomorig::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using std::chrono::duration;
+using std::chrono::duration_cast;
+
+struct ReplayOptions {
+  std::string file;
+  std::string to = "tcp://127.0.0.1:5555";
+  bool connect = false;
+  bool allow_remote = false;
+  std::string rate = "recorded";
+  bool loop = false;
+  std::string sets;
+  double timeout_s = 10.0;
+  double wait_s = 60.0;
+};
+
+double seconds_since(Clock::time_point t) { return duration<double>(Clock::now() - t).count(); }
+
+// One status line on stderr: rewritten in place on a terminal, one line per second in a log.
+class ReplayStatus {
+ public:
+  ReplayStatus() : tty_(isatty(STDERR_FILENO) == 1), started_(Clock::now()), last_(started_) {}
+
+  void update(const stream::SenderStats& s, std::uint64_t blocked_sets, bool final = false) {
+    const auto now = Clock::now();
+    if (!final && duration<double>(now - last_).count() < (tty_ ? 0.25 : 1.0)) return;
+    const double dt = duration<double>(now - last_).count();
+    const double rate = dt > 0 ? static_cast<double>(s.sets_sent - last_sets_) / dt : 0.0;
+    const double mbps = dt > 0 ? static_cast<double>(s.bytes_sent - last_bytes_) / dt / 1e6 : 0.0;
+    fmt::print(stderr, "{}replay: {} sets sent  {:.1f} sets/s  {:.1f} MB/s  {} blocked sends{}", tty_ ? "\r" : "",
+               s.sets_sent, rate, mbps, blocked_sets, tty_ && !final ? "   " : "\n");
+    last_ = now;
+    last_sets_ = s.sets_sent;
+    last_bytes_ = s.bytes_sent;
+  }
+
+ private:
+  bool tty_;
+  Clock::time_point started_, last_;
+  std::uint64_t last_sets_ = 0, last_bytes_ = 0;
+};
+
+enum class SendOutcome { sent, stopped };
+
+// Sends one set, retrying while the receiver is absent or slow, up to `limit`. A signal
+// interrupts ZeroMQ's wait (EINTR); then the stop flag decides.
+SendOutcome send_set(stream::FrameSender& sender, const FrameSet& set, double limit_s, const StopSignalGuard& stop) {
+  const auto begin = Clock::now();
+  for (;;) {
+    try {
+      if (sender.send(set)) return SendOutcome::sent;
+    } catch (const zmq::error_t& e) {
+      if (e.num() != EINTR)
+        throw runtime_error(fmt::format("sending set {} on {} failed: {}", set.set_index, sender.endpoint(), e.what()));
+    }
+    if (stop.stop_requested()) return SendOutcome::stopped;
+    if (seconds_since(begin) >= limit_s)
+      throw runtime_error(fmt::format(
+          "no receiver took set {} within {:g} s on {}: the receiver vanished or stalled (is 'tomorig record "
+          "--from {}' running? for a slow receiver raise --timeout, or --wait for the first set)",
+          set.set_index, limit_s, sender.endpoint(), sender.endpoint()));
+  }
+}
+
+void replay(const ReplayOptions& opt) {
+  if (!(opt.timeout_s > 0.0) || !(opt.wait_s > 0.0))
+    throw bad_input(fmt::format("--timeout {:g} / --wait {:g} are invalid: both must be > 0 seconds", opt.timeout_s,
+                                opt.wait_s));
+  const ReplayRate rate = parse_replay_rate(opt.rate);
+  const storage::SessionReader session(opt.file);
+  if (session.set_count() == 0)
+    throw bad_input(fmt::format("session '{}' holds no sets: nothing to replay", opt.file));
+  const SetRange range = opt.sets.empty() ? SetRange{0, session.set_count()}
+                                          : parse_set_range(opt.sets, session.set_count());
+  std::vector<std::int64_t> trigger_ns;
+  for (std::uint64_t i = range.first; i < range.last; ++i)
+    trigger_ns.push_back(session.set_record(i).trigger_timestamp_ns);
+  const ReplaySchedule schedule = make_replay_schedule(rate, trigger_ns);
+
+  StopSignalGuard stop;
+  zmq::context_t context(1);
+  stream::SocketOptions socket;
+  socket.endpoint = {opt.to, !opt.connect, opt.allow_remote};
+  socket.timeout = duration_cast<std::chrono::milliseconds>(duration<double>(opt.timeout_s));
+  auto sender = std::make_unique<stream::FrameSender>(context, socket);
+  // The first line names the real endpoint (a "*" port resolved), for scripts and tests.
+  fmt::print(stderr, "replay: {} {}, sets {} to {} of {}, rate {}{}\n", opt.connect ? "connected to" : "sending on",
+             sender->endpoint(), range.first, range.last - 1, opt.file, opt.rate, opt.loop ? ", looping" : "");
+  std::fflush(stderr);
+
+  ReplayStatus status;
+  std::uint64_t blocked_sets = 0;
+  bool stopped = false;
+  auto pass_start = Clock::now();
+  do {
+    for (std::uint64_t i = range.first; i < range.last && !stopped; ++i) {
+      const auto due = pass_start + schedule.due[i - range.first];
+      if (stop.wait_for(due - Clock::now())) { stopped = true; break; }
+      FrameSet set = session.read_set(i);
+      set.set_index = i;
+      const std::uint64_t blocked_before = sender->stats().blocked_sends;
+      const bool first = sender->stats().sets_sent == 0;
+      stopped = send_set(*sender, set, first ? opt.wait_s : opt.timeout_s, stop) == SendOutcome::stopped;
+      if (sender->stats().blocked_sends != blocked_before) ++blocked_sets;
+      status.update(sender->stats(), blocked_sets);
+    }
+    pass_start = rate.mode == ReplayRate::Mode::max ? Clock::now() : pass_start + schedule.pass_length;
+  } while (opt.loop && !stopped && !stop.stop_requested());
+  stopped = stopped || stop.stop_requested();
+
+  // Hand every queued set to the transport: closing the context waits (up to the linger, one
+  // --timeout) until ZeroMQ has written all queued messages to the receiver. Waiting the whole
+  // linger means it gave up with sets still queued.
+  const stream::SenderStats sent = sender->stats();
+  const std::string endpoint = sender->endpoint();
+  sender.reset();
+  const auto closing = Clock::now();
+  context.close();
+  const bool drained = seconds_since(closing) + 0.05 < opt.timeout_s;
+  status.update(sent, blocked_sets, /*final=*/true);
+  if (!drained)
+    throw runtime_error(fmt::format("the receiver on {} stopped taking sets: sets still queued after {:g} s were "
+                                    "lost ({} sets were handed to the transport)",
+                                    endpoint, opt.timeout_s, sent.sets_sent));
+  fmt::print("replayed {} sets ({:.1f} MB) from {} on {}{}\n", sent.sets_sent, static_cast<double>(sent.bytes_sent) / 1e6,
+             opt.file, endpoint, stopped ? fmt::format(", stopped by {}", stop.signal_name()) : std::string());
+}
+
+}  // namespace
+
+void add_replay_command(CLI::App& root) {
+  auto opt = std::make_shared<ReplayOptions>();
+  CLI::App* cmd = root.add_subcommand(
+      "replay", "Publish a session's frame sets on the lossless stream (binds; 'tomorig record' connects)");
+  cmd->add_option("file", opt->file, "Session file (.h5) to replay")->required();
+  cmd->add_option("--to", opt->to,
+                  "Stream endpoint; replay binds it (loopback only unless --allow-remote). A port * binds any "
+                  "free port, printed on stderr")
+      ->capture_default_str();
+  cmd->add_flag("--connect", opt->connect, "Connect to a receiver that binds (e.g. 'tomorig record --bind')");
+  cmd->add_flag("--allow-remote", opt->allow_remote, "Allow binding to a non-loopback address");
+  cmd->add_option("--rate", opt->rate, "recorded (trigger timestamps) | max | a rate in Hz")->capture_default_str();
+  cmd->add_flag("--loop", opt->loop, "Start over after the last set, until Ctrl-C");
+  cmd->add_option("--sets", opt->sets, "Sets to send: A:B (A to B-1), A:, :B or A");
+  cmd->add_option("--timeout", opt->timeout_s, "Seconds a send may wait for the receiver before giving up")
+      ->capture_default_str();
+  cmd->add_option("--wait", opt->wait_s,
+                  "Seconds to wait for a receiver before the first set (at least one --timeout)")->capture_default_str();
+  cmd->callback([opt] { replay(*opt); });
+}
+
+}  // namespace tomorig::app

@@ -1,0 +1,62 @@
+// One full multi-grid correlation (binned 2x pass, integer-offset pass, two B-spline
+// deformation passes) of a tpiv-thesis-sized 512 x 512 x 160 pair: particles at ~10 per
+// 64 x 64 x 32 window (thesis Sect. 3.3-3.4), Taylor-Green displacement A = 5, p = 256 voxel.
+#include <random>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+
+#include "tomorig/processing/correlation/correlate.h"
+#include "tomorig/processing/quality/gaussian_blobs.h"
+#include "tomorig/simulators/taylor_green.h"
+
+namespace {
+
+struct Pair {
+  tomorig::DenseVolume a, b;
+};
+
+const Pair& thesis_pair() {
+  static const Pair pair = [] {
+    const tomorig::VoxelGrid grid = tomorig::VoxelGrid::centred(512, 512, 160, 0.0195);
+    const tomorig::sim::TaylorGreenFlow flow(grid, 5.0, 256.0);
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<double> ux(0, 511), uy(0, 511), uz(0, 159);
+    const int count = 13107;  // 0.05 ppp of a 512 x 512 image
+    std::vector<tomorig::Vec3d> pa, pb;
+    for (int n = 0; n < count; ++n) {
+      const tomorig::Vec3d x{ux(rng), uy(rng), uz(rng)};
+      const tomorig::Vec3d d = flow.displacement_voxel(x);
+      const tomorig::Vec3d xa = x - d * 0.5, xb = x + d * 0.5;
+      pa.push_back(grid.centre_of(xa.x, xa.y, xa.z));
+      pb.push_back(grid.centre_of(xb.x, xb.y, xb.z));
+    }
+    return Pair{tomorig::quality::gaussian_blob_volume(grid, pa).to_dense(),
+                tomorig::quality::gaussian_blob_volume(grid, pb).to_dense()};
+  }();
+  return pair;
+}
+
+void run(benchmark::State& state, tomorig::piv::WindowSize window) {
+  const Pair& pair = thesis_pair();
+  auto options = tomorig::piv::CorrelationOptions::multigrid(window, 0.75, 2);
+  options.threads = static_cast<int>(state.range(0));
+  tomorig::piv::CorrelationReport report;
+  for (auto _ : state) {
+    const auto field = tomorig::piv::correlate(pair.a, pair.b, options, report);
+    benchmark::DoNotOptimize(field.displacement.data());
+  }
+  state.counters["nodes_final"] = static_cast<double>(report.passes.back().nodes_x) * report.passes.back().nodes_y *
+                                  report.passes.back().nodes_z;
+  for (std::size_t p = 0; p < report.passes.size(); ++p)
+    state.counters["s_pass" + std::to_string(p)] = report.passes[p].seconds;
+  state.counters["valid_fraction"] = report.valid_fraction();
+}
+
+void BM_Correlate_512x512x160_64x64x32(benchmark::State& state) { run(state, {64, 64, 32}); }
+void BM_Correlate_512x512x160_48cubed(benchmark::State& state) { run(state, {48, 48, 48}); }
+
+BENCHMARK(BM_Correlate_512x512x160_64x64x32)->Arg(2)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+BENCHMARK(BM_Correlate_512x512x160_48cubed)->Arg(2)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+
+}  // namespace

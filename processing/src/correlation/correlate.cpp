@@ -1,0 +1,224 @@
+#include "tomorig/processing/correlation/correlate.h"
+
+#include <omp.h>
+
+#include <chrono>
+#include <cmath>
+#include <map>
+
+#include <fmt/core.h>
+
+#include "correlation/fft_correlator.h"
+#include "correlation/predictor_filters.h"
+#include "correlation/volume_deformation.h"
+#include "tomorig/core/error.h"
+#include "tomorig/processing/correlation/vector_validation.h"
+
+namespace tomorig::piv {
+namespace {
+
+using detail::Int3;
+using detail::VolumeView;
+
+// The pair of volumes at one binning factor, with B-spline coefficients made on demand.
+struct Level {
+  std::vector<float> a, b;              // binned samples (empty for factor 1: the inputs are used)
+  VolumeView view_a, view_b;
+  std::vector<float> coef_a, coef_b;    // cubic B-spline coefficients, empty until needed
+  std::vector<float> deformed_a, deformed_b;
+};
+
+// Where the windows of a pass sit, in voxels of its (binned) level.
+struct PassGeometry {
+  Int3 window, step, nodes;
+  int factor = 1;
+  // Full-grid voxel coordinate of node n's centre along an axis.
+  double centre(int n, int step_axis, int window_axis) const {
+    return factor * (n * step_axis + 0.5 * (window_axis - 1)) + 0.5 * (factor - 1);
+  }
+};
+
+PassGeometry geometry_of(const CorrelationPass& pass, const VolumeView& level) {
+  PassGeometry g;
+  g.factor = pass.downsample;
+  g.window = {pass.window.x / g.factor, pass.window.y / g.factor, pass.window.z / g.factor};
+  auto step = [&](int w) { return std::max(1, static_cast<int>(std::lround(w * (1.0 - pass.overlap)))); };
+  g.step = {step(g.window.x), step(g.window.y), step(g.window.z)};
+  g.nodes = {(level.nx - g.window.x) / g.step.x + 1, (level.ny - g.window.y) / g.step.y + 1,
+             (level.nz - g.window.z) / g.step.z + 1};
+  return g;
+}
+
+bool same_grid(const VoxelGrid& a, const VoxelGrid& b) {
+  return a.nx == b.nx && a.ny == b.ny && a.nz == b.nz && a.voxel_size == b.voxel_size && a.origin.x == b.origin.x &&
+         a.origin.y == b.origin.y && a.origin.z == b.origin.z;
+}
+
+int floor_half(int v) { return static_cast<int>(std::floor(v / 2.0)); }
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+double CorrelationReport::valid_fraction() const {
+  const std::size_t total = valid + replaced + invalid;
+  return total ? static_cast<double>(valid) / static_cast<double>(total) : 0.0;
+}
+
+VectorField correlate(const DenseVolume& a, const DenseVolume& b, const CorrelationOptions& options,
+                      CorrelationReport& report) {
+  const auto start_total = std::chrono::steady_clock::now();
+  if (!same_grid(a.grid, b.grid))
+    throw bad_input(fmt::format("correlation: the volumes lie on different grids ({} x {} x {} and {} x {} x {} voxels, "
+                                "voxel size {} and {} mm); reconstruct both exposures on the same grid",
+                                a.grid.nx, a.grid.ny, a.grid.nz, b.grid.nx, b.grid.ny, b.grid.nz, a.grid.voxel_size,
+                                b.grid.voxel_size));
+  options.validate(a.grid);
+  if (a.values.size() != a.grid.voxel_count() || b.values.size() != b.grid.voxel_count())
+    throw bad_input("correlation: a volume holds fewer values than its grid has voxels");
+  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  report = {};
+
+  std::map<int, Level> levels;
+  auto level_for = [&](int factor) -> Level& {
+    Level& level = levels[factor];
+    if (level.view_a.data) return level;
+    const VolumeView full_a{a.values.data(), a.grid.nx, a.grid.ny, a.grid.nz};
+    const VolumeView full_b{b.values.data(), b.grid.nx, b.grid.ny, b.grid.nz};
+    if (factor == 1) {
+      level.view_a = full_a;
+      level.view_b = full_b;
+    } else {
+      level.a = detail::downsample_sum(full_a, factor, threads);
+      level.b = detail::downsample_sum(full_b, factor, threads);
+      level.view_a = {level.a.data(), a.grid.nx / factor, a.grid.ny / factor, a.grid.nz / factor};
+      level.view_b = {level.b.data(), a.grid.nx / factor, a.grid.ny / factor, a.grid.nz / factor};
+    }
+    return level;
+  };
+
+  VectorField predictor;  // voxel units: origin/spacing in full-grid voxel coordinates
+  bool have_predictor = false;
+  VectorField field;
+  for (std::size_t p = 0; p < options.passes.size(); ++p) {
+    const auto start_pass = std::chrono::steady_clock::now();
+    const CorrelationPass& pass = options.passes[p];
+    Level& level = level_for(pass.downsample);
+    const PassGeometry g = geometry_of(pass, level.view_a);
+    const bool deform = pass.deformation && have_predictor;
+
+    VolumeView va = level.view_a, vb = level.view_b;
+    if (deform) {
+      if (pass.interpolation == Interpolation::cubic_bspline) {
+        if (level.coef_a.empty()) {
+          level.coef_a.assign(level.view_a.data, level.view_a.data + level.view_a.count());
+          level.coef_b.assign(level.view_b.data, level.view_b.data + level.view_b.count());
+          detail::bspline_prefilter(level.coef_a, va.nx, va.ny, va.nz, threads);
+          detail::bspline_prefilter(level.coef_b, vb.nx, vb.ny, vb.nz, threads);
+        }
+        va.data = level.coef_a.data();
+        vb.data = level.coef_b.data();
+      }
+      detail::deform_pair(va, vb, predictor, g.factor, pass.interpolation, level.deformed_a, level.deformed_b, threads);
+      va.data = level.deformed_a.data();
+      vb.data = level.deformed_b.data();
+    }
+
+    field = VectorField(g.nodes.x, g.nodes.y, g.nodes.z);
+    field.origin = {g.centre(0, g.step.x, g.window.x), g.centre(0, g.step.y, g.window.y), g.centre(0, g.step.z, g.window.z)};
+    field.spacing = {double(g.factor * g.step.x), double(g.factor * g.step.y), double(g.factor * g.step.z)};
+
+    const detail::FftCorrelator correlator(g.window, options.weighting);
+    const long long node_count = static_cast<long long>(field.count());
+    std::size_t fallbacks = 0;
+#pragma omp parallel num_threads(threads) reduction(+ : fallbacks)
+    {
+      auto scratch = correlator.make_scratch();  // once per thread and pass, never per window
+#pragma omp for schedule(dynamic, 4)
+      for (long long n = 0; n < node_count; ++n) {
+        const int i = static_cast<int>(n % g.nodes.x);
+        const int j = static_cast<int>((n / g.nodes.x) % g.nodes.y);
+        const int k = static_cast<int>(n / (static_cast<long long>(g.nodes.x) * g.nodes.y));
+        const Int3 start{i * g.step.x, j * g.step.y, k * g.step.z};
+        // Predicted displacement at the node, in voxels of this level.
+        Vec3f predicted{};
+        if (have_predictor) {
+          const Vec3f d = detail::sample_field(predictor, field.origin.x + i * field.spacing.x,
+                                               field.origin.y + j * field.spacing.y, field.origin.z + k * field.spacing.z);
+          predicted = {d.x / g.factor, d.y / g.factor, d.z / g.factor};
+        }
+        Int3 offset{};  // integer displacement between the windows, split symmetrically
+        if (have_predictor && !deform)
+          offset = {static_cast<int>(std::lround(predicted.x)), static_cast<int>(std::lround(predicted.y)),
+                    static_cast<int>(std::lround(predicted.z))};
+        const Int3 start_a{start.x - floor_half(offset.x), start.y - floor_half(offset.y), start.z - floor_half(offset.z)};
+        const Int3 start_b{start_a.x + offset.x, start_a.y + offset.y, start_a.z + offset.z};
+        const detail::WindowPeak peak = correlator.correlate(va, start_a, vb, start_b, scratch);
+        fallbacks += peak.fallbacks;
+        if (!peak.valid) continue;  // stays invalid with peak 0
+        const Vec3f base = deform ? predicted : Vec3f{float(offset.x), float(offset.y), float(offset.z)};
+        field.displacement[n] = {(base.x + peak.dx) * g.factor, (base.y + peak.dy) * g.factor, (base.z + peak.dz) * g.factor};
+        field.peak[n] = peak.peak;
+        field.status[n] = VectorStatus::valid;
+      }
+    }
+
+    std::vector<std::uint8_t> mask;
+    if (options.illumination) {
+      mask.resize(field.count());
+      for (int k = 0; k < field.nz; ++k)
+        for (int j = 0; j < field.ny; ++j)
+          for (int i = 0; i < field.nx; ++i) {
+            const Vec3d world = a.grid.centre_of(field.origin.x + i * field.spacing.x, field.origin.y + j * field.spacing.y,
+                                                 field.origin.z + k * field.spacing.z);
+            mask[field.linear(i, j, k)] = options.illumination(world) >= options.min_illumination;
+          }
+    }
+    const ValidationCounts counts = validate_field(field, options, mask);
+
+    PassReport pr;
+    pr.nodes_x = field.nx;
+    pr.nodes_y = field.ny;
+    pr.nodes_z = field.nz;
+    pr.low_peak = counts.low_peak;
+    pr.too_large = counts.too_large;
+    pr.median_outliers = counts.median_outliers;
+    pr.replaced = counts.replaced;
+    pr.masked = counts.masked;
+    pr.peak_fallbacks = fallbacks;
+
+    if (p + 1 < options.passes.size()) {
+      predictor = field;
+      detail::fill_invalid(predictor);
+      if (options.smooth_predictor) detail::smooth_gaussian3(predictor);
+      have_predictor = true;
+    }
+    pr.seconds = seconds_since(start_pass);
+    report.passes.push_back(pr);
+  }
+
+  // Node positions from full-grid voxel coordinates to world mm.
+  field.origin = a.grid.centre_of(field.origin.x, field.origin.y, field.origin.z);
+  field.spacing = field.spacing * a.grid.voxel_size;
+  for (VectorStatus s : field.status) {
+    report.valid += s == VectorStatus::valid;
+    report.replaced += s == VectorStatus::replaced;
+    report.invalid += s == VectorStatus::invalid;
+  }
+  report.seconds_total = seconds_since(start_total);
+  return field;
+}
+
+VectorField correlate(const SparseVolume& a, const SparseVolume& b, const CorrelationOptions& options,
+                      CorrelationReport& report) {
+  if (!same_grid(a.grid, b.grid))
+    throw bad_input(fmt::format("correlation: the volumes lie on different grids ({} x {} x {} and {} x {} x {} voxels); "
+                                "reconstruct both exposures on the same grid",
+                                a.grid.nx, a.grid.ny, a.grid.nz, b.grid.nx, b.grid.ny, b.grid.nz));
+  options.validate(a.grid);
+  return correlate(a.to_dense(), b.to_dense(), options, report);
+}
+
+}  // namespace tomorig::piv

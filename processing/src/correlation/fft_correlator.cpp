@@ -1,0 +1,194 @@
+#include "correlation/fft_correlator.h"
+
+#include <fftw3.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <numbers>
+#include <tuple>
+
+#include "tomorig/core/error.h"
+#include "tomorig/processing/correlation/peak_fit.h"
+
+namespace tomorig::piv::detail {
+namespace {
+
+struct PlanPair {
+  fftwf_plan forward = nullptr;   // r2c
+  fftwf_plan backward = nullptr;  // c2r
+};
+
+// FFTW's planner is not thread-safe; plan execution with the new-array functions is. Plans
+// live for the process, one pair per window size, like FFTW's own wisdom.
+std::mutex& planner_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+const PlanPair& plans_for(Int3 w) {
+  static std::map<std::tuple<int, int, int>, PlanPair> cache;
+  std::lock_guard lock(planner_mutex());
+  auto [it, inserted] = cache.try_emplace({w.x, w.y, w.z});
+  if (inserted) {
+    const std::size_t real = static_cast<std::size_t>(w.x) * w.y * w.z;
+    const std::size_t complex = static_cast<std::size_t>(w.x / 2 + 1) * w.y * w.z;
+    std::unique_ptr<float, FftwFree> r(fftwf_alloc_real(real));
+    std::unique_ptr<float, FftwFree> c(reinterpret_cast<float*>(fftwf_alloc_complex(complex)));
+    auto* cc = reinterpret_cast<fftwf_complex*>(c.get());
+    // FFTW takes dimensions slowest first: z, y, x.
+    it->second.forward = fftwf_plan_dft_r2c_3d(w.z, w.y, w.x, r.get(), cc, FFTW_MEASURE);
+    it->second.backward = fftwf_plan_dft_c2r_3d(w.z, w.y, w.x, cc, r.get(), FFTW_MEASURE);
+    if (!it->second.forward || !it->second.backward) {
+      cache.erase(it);
+      throw runtime_error("correlation: FFTW could not plan a window of " + std::to_string(w.x) + " x " +
+                          std::to_string(w.y) + " x " + std::to_string(w.z));
+    }
+  }
+  return it->second;
+}
+
+std::vector<float> axis_weights(int n, WindowWeighting weighting) {
+  std::vector<float> w(n, 1.0f);
+  const double centre = 0.5 * (n - 1);
+  for (int i = 0; i < n; ++i) {
+    const double u = (i - centre) / n;  // -0.5 .. 0.5
+    if (weighting == WindowWeighting::gaussian) w[i] = static_cast<float>(std::exp(-0.5 * (u / 0.25) * (u / 0.25)));
+    if (weighting == WindowWeighting::hann)
+      w[i] = static_cast<float>(0.5 + 0.5 * std::cos(2.0 * std::numbers::pi * (i + 0.5 - 0.5 * n) / n));
+  }
+  return w;
+}
+
+int signed_lag(int index, int size) { return index < size / 2 ? index : index - size; }
+
+}  // namespace
+
+void FftwFree::operator()(void* p) const { fftwf_free(p); }
+
+FftCorrelator::FftCorrelator(Int3 window, WindowWeighting weighting)
+    : window_(window),
+      real_count_(static_cast<std::size_t>(window.x) * window.y * window.z),
+      complex_count_(static_cast<std::size_t>(window.x / 2 + 1) * window.y * window.z) {
+  plans_ = &plans_for(window);
+  if (weighting != WindowWeighting::top_hat) {
+    const auto wx = axis_weights(window.x, weighting), wy = axis_weights(window.y, weighting),
+               wz = axis_weights(window.z, weighting);
+    weights_.resize(real_count_);
+    std::size_t n = 0;
+    for (int k = 0; k < window.z; ++k)
+      for (int j = 0; j < window.y; ++j)
+        for (int i = 0; i < window.x; ++i) weights_[n++] = wx[i] * wy[j] * wz[k];
+  }
+}
+
+FftCorrelator::Scratch FftCorrelator::make_scratch() const {
+  Scratch s;
+  s.a.reset(fftwf_alloc_real(real_count_));
+  s.b.reset(fftwf_alloc_real(real_count_));
+  s.spectrum_a.reset(reinterpret_cast<float*>(fftwf_alloc_complex(complex_count_)));
+  s.spectrum_b.reset(reinterpret_cast<float*>(fftwf_alloc_complex(complex_count_)));
+  if (!s.a || !s.b || !s.spectrum_a || !s.spectrum_b) throw runtime_error("correlation: out of memory for FFT buffers");
+  return s;
+}
+
+double FftCorrelator::load_window(const VolumeView& v, Int3 start, float* out) const {
+  const int x0 = std::max(0, start.x), x1 = std::min(v.nx, start.x + window_.x);
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (int k = 0; k < window_.z; ++k) {
+    const int z = start.z + k;
+    for (int j = 0; j < window_.y; ++j, n += window_.x) {
+      const int y = start.y + j;
+      float* row = out + n;
+      if (z < 0 || z >= v.nz || y < 0 || y >= v.ny || x0 >= x1) {
+        std::fill(row, row + window_.x, 0.0f);
+        continue;
+      }
+      const float* src = v.data + v.linear(0, y, z);
+      std::fill(row, row + (x0 - start.x), 0.0f);
+      float row_sum = 0.0f;
+      for (int x = x0; x < x1; ++x) {
+        row[x - start.x] = src[x];
+        row_sum += src[x];
+      }
+      std::fill(row + (x1 - start.x), row + window_.x, 0.0f);
+      sum += row_sum;
+    }
+  }
+  const float mean = static_cast<float>(sum / static_cast<double>(real_count_));
+  double energy = 0.0;
+  if (weights_.empty()) {
+    for (std::size_t m = 0; m < real_count_; ++m) {
+      out[m] -= mean;
+      energy += double(out[m]) * out[m];
+    }
+  } else {
+    for (std::size_t m = 0; m < real_count_; ++m) {
+      out[m] = (out[m] - mean) * weights_[m];
+      energy += double(out[m]) * out[m];
+    }
+  }
+  return energy;
+}
+
+WindowPeak FftCorrelator::correlate(const VolumeView& va, Int3 start_a, const VolumeView& vb, Int3 start_b,
+                                    Scratch& s) const {
+  WindowPeak result;
+  const double energy_a = load_window(va, start_a, s.a.get());
+  const double energy_b = load_window(vb, start_b, s.b.get());
+  // A window without contrast has no defined correlation coefficient (Eq. 2.16 divides by 0).
+  if (!(energy_a > 1e-20) || !(energy_b > 1e-20)) return result;
+
+  const auto& plans = *static_cast<const PlanPair*>(plans_);
+  auto* fa = reinterpret_cast<fftwf_complex*>(s.spectrum_a.get());
+  auto* fb = reinterpret_cast<fftwf_complex*>(s.spectrum_b.get());
+  fftwf_execute_dft_r2c(plans.forward, s.a.get(), fa);
+  fftwf_execute_dft_r2c(plans.forward, s.b.get(), fb);
+  // conj(A) * B: the correlation peaks at the displacement of b relative to a.
+  for (std::size_t m = 0; m < complex_count_; ++m) {
+    const float ar = fa[m][0], ai = fa[m][1], br = fb[m][0], bi = fb[m][1];
+    fa[m][0] = ar * br + ai * bi;
+    fa[m][1] = ar * bi - ai * br;
+  }
+  float* plane = s.a.get();
+  fftwf_execute_dft_c2r(plans.backward, fa, plane);
+
+  std::size_t best = 0;
+  float best_value = plane[0];
+  for (std::size_t m = 1; m < real_count_; ++m)
+    if (plane[m] > best_value) {
+      best_value = plane[m];
+      best = m;
+    }
+  // FFTW's inverse is unnormalised (factor N); Eq. 2.16 divides by the standard deviations.
+  const double scale = 1.0 / (static_cast<double>(real_count_) * std::sqrt(energy_a * energy_b));
+  const int ix = static_cast<int>(best % window_.x);
+  const int iy = static_cast<int>((best / window_.x) % window_.y);
+  const int iz = static_cast<int>(best / (static_cast<std::size_t>(window_.x) * window_.y));
+  auto at = [&](int x, int y, int z) {
+    x = (x + window_.x) % window_.x;
+    y = (y + window_.y) % window_.y;
+    z = (z + window_.z) % window_.z;
+    return static_cast<double>(plane[x + static_cast<std::size_t>(window_.x) * (y + static_cast<std::size_t>(window_.y) * z)]);
+  };
+  const double centre = best_value;
+  auto fit_axis = [&](int index, int size, double left, double right) {
+    const int lag = signed_lag(index, size);
+    // The lowest and highest lags border the periodic wrap: their outer neighbour is the
+    // opposite end of the plane, not a neighbouring displacement.
+    const bool has_left = lag > size / 2 - size, has_right = lag < size / 2 - 1;
+    const PeakFit1d fit = fit_peak_1d(left, centre, right, has_left, has_right);
+    if (fit.method != PeakFitMethod::gaussian) ++result.fallbacks;
+    return lag + fit.offset;
+  };
+  result.dx = static_cast<float>(fit_axis(ix, window_.x, at(ix - 1, iy, iz), at(ix + 1, iy, iz)));
+  result.dy = static_cast<float>(fit_axis(iy, window_.y, at(ix, iy - 1, iz), at(ix, iy + 1, iz)));
+  result.dz = static_cast<float>(fit_axis(iz, window_.z, at(ix, iy, iz - 1), at(ix, iy, iz + 1)));
+  result.peak = static_cast<float>(centre * scale);
+  result.valid = true;
+  return result;
+}
+
+}  // namespace tomorig::piv::detail

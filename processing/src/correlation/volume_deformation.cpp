@@ -1,0 +1,204 @@
+#include "correlation/volume_deformation.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace tomorig::piv::detail {
+namespace {
+
+int thread_count(int threads) { return threads > 0 ? threads : omp_get_max_threads(); }
+
+// One line of the recursive cubic B-spline prefilter (pole sqrt(3) - 2, mirror boundaries).
+void prefilter_line(float* c, int n) {
+  if (n < 2) return;
+  constexpr double pole = -0.2679491924311228;  // sqrt(3) - 2
+  constexpr double gain = 6.0;                  // (1 - pole)(1 - 1 / pole)
+  for (int k = 0; k < n; ++k) c[k] = static_cast<float>(c[k] * gain);
+  // Causal initialisation: the mirrored sum, truncated where pole^k is negligible.
+  const int horizon = std::min(n, 30);
+  double sum = c[0], zk = pole;
+  for (int k = 1; k < horizon; ++k, zk *= pole) sum += zk * c[k];
+  c[0] = static_cast<float>(sum);
+  for (int k = 1; k < n; ++k) c[k] = static_cast<float>(c[k] + pole * c[k - 1]);
+  c[n - 1] = static_cast<float>(pole / (pole * pole - 1.0) * (c[n - 1] + pole * c[n - 2]));
+  for (int k = n - 2; k >= 0; --k) c[k] = static_cast<float>(pole * (c[k + 1] - c[k]));
+}
+
+float sample_trilinear(const VolumeView& v, float x, float y, float z) {
+  const int i = static_cast<int>(std::floor(x)), j = static_cast<int>(std::floor(y)), k = static_cast<int>(std::floor(z));
+  const float fx = x - i, fy = y - j, fz = z - k;
+  float result = 0.0f;
+  for (int dk = 0; dk <= 1; ++dk) {
+    const int zz = k + dk;
+    if (zz < 0 || zz >= v.nz) continue;
+    const float wz = dk ? fz : 1.0f - fz;
+    for (int dj = 0; dj <= 1; ++dj) {
+      const int yy = j + dj;
+      if (yy < 0 || yy >= v.ny) continue;
+      const float wy = dj ? fy : 1.0f - fy;
+      const float* row = v.data + v.linear(0, yy, zz);
+      float line = 0.0f;
+      if (i >= 0 && i < v.nx) line += (1.0f - fx) * row[i];
+      if (i + 1 >= 0 && i + 1 < v.nx) line += fx * row[i + 1];
+      result += wz * wy * line;
+    }
+  }
+  return result;
+}
+
+void bspline_weights(float t, float w[4]) {
+  const float t2 = t * t, t3 = t2 * t, u = 1.0f - t;
+  w[0] = u * u * u / 6.0f;
+  w[1] = (4.0f - 6.0f * t2 + 3.0f * t3) / 6.0f;
+  w[2] = (1.0f + 3.0f * t + 3.0f * t2 - 3.0f * t3) / 6.0f;
+  w[3] = t3 / 6.0f;
+}
+
+int mirror(int i, int n) {
+  if (n == 1) return 0;
+  const int period = 2 * n - 2;
+  i = std::abs(i) % period;
+  return i < n ? i : period - i;
+}
+
+float sample_bspline(const VolumeView& c, float x, float y, float z) {
+  if (x < -0.5f || y < -0.5f || z < -0.5f || x > c.nx - 0.5f || y > c.ny - 0.5f || z > c.nz - 0.5f) return 0.0f;
+  const int i = static_cast<int>(std::floor(x)), j = static_cast<int>(std::floor(y)), k = static_cast<int>(std::floor(z));
+  float wx[4], wy[4], wz[4];
+  bspline_weights(x - i, wx);
+  bspline_weights(y - j, wy);
+  bspline_weights(z - k, wz);
+  float result = 0.0f;
+  if (i >= 1 && j >= 1 && k >= 1 && i + 2 < c.nx && j + 2 < c.ny && k + 2 < c.nz) {
+    // Interior: the 4 x 4 x 4 support needs no mirroring (almost every voxel).
+    const float* base = c.data + c.linear(i - 1, j - 1, k - 1);
+    const std::size_t sy = static_cast<std::size_t>(c.nx), sz = sy * static_cast<std::size_t>(c.ny);
+    for (int dk = 0; dk < 4; ++dk) {
+      float plane = 0.0f;
+      for (int dj = 0; dj < 4; ++dj) {
+        const float* row = base + dk * sz + dj * sy;
+        plane += wy[dj] * (wx[0] * row[0] + wx[1] * row[1] + wx[2] * row[2] + wx[3] * row[3]);
+      }
+      result += wz[dk] * plane;
+    }
+    return result;
+  }
+  int ix[4];
+  for (int a = 0; a < 4; ++a) ix[a] = mirror(i - 1 + a, c.nx);
+  for (int dk = 0; dk < 4; ++dk) {
+    const int zz = mirror(k - 1 + dk, c.nz);
+    for (int dj = 0; dj < 4; ++dj) {
+      const float* row = c.data + c.linear(0, mirror(j - 1 + dj, c.ny), zz);
+      const float line = wx[0] * row[ix[0]] + wx[1] * row[ix[1]] + wx[2] * row[ix[2]] + wx[3] * row[ix[3]];
+      result += wz[dk] * wy[dj] * line;
+    }
+  }
+  return result;
+}
+
+}  // namespace
+
+std::vector<float> downsample_sum(const VolumeView& v, int factor, int threads) {
+  const int nx = v.nx / factor, ny = v.ny / factor, nz = v.nz / factor;
+  std::vector<float> out(static_cast<std::size_t>(nx) * ny * nz, 0.0f);
+#pragma omp parallel for num_threads(thread_count(threads)) schedule(static)
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j) {
+      float* dst = out.data() + static_cast<std::size_t>(nx) * (j + static_cast<std::size_t>(ny) * k);
+      for (int dk = 0; dk < factor; ++dk)
+        for (int dj = 0; dj < factor; ++dj) {
+          const float* src = v.data + v.linear(0, j * factor + dj, k * factor + dk);
+          for (int i = 0; i < nx; ++i)
+            for (int di = 0; di < factor; ++di) dst[i] += src[i * factor + di];
+        }
+    }
+  return out;
+}
+
+void bspline_prefilter(std::vector<float>& values, int nx, int ny, int nz, int threads) {
+  const int t = thread_count(threads);
+  const std::size_t sx = 1, sy = nx, sz = static_cast<std::size_t>(nx) * ny;
+#pragma omp parallel num_threads(t)
+  {
+    std::vector<float> line(std::max({nx, ny, nz}));
+#pragma omp for schedule(static)
+    for (int k = 0; k < nz; ++k)
+      for (int j = 0; j < ny; ++j) prefilter_line(values.data() + j * sy + k * sz, nx);
+#pragma omp for schedule(static)
+    for (int k = 0; k < nz; ++k)
+      for (int i = 0; i < nx; ++i) {
+        float* base = values.data() + i * sx + k * sz;
+        for (int j = 0; j < ny; ++j) line[j] = base[j * sy];
+        prefilter_line(line.data(), ny);
+        for (int j = 0; j < ny; ++j) base[j * sy] = line[j];
+      }
+#pragma omp for schedule(static)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        float* base = values.data() + i * sx + j * sy;
+        for (int k = 0; k < nz; ++k) line[k] = base[k * sz];
+        prefilter_line(line.data(), nz);
+        for (int k = 0; k < nz; ++k) base[k * sz] = line[k];
+      }
+  }
+}
+
+Vec3f sample_field(const VectorField& f, double x, double y, double z) {
+  auto locate = [](double p, double origin, double spacing, int n, int& i0, double& frac) {
+    double u = spacing > 0 ? (p - origin) / spacing : 0.0;
+    u = std::clamp(u, 0.0, static_cast<double>(n - 1));
+    i0 = std::min(static_cast<int>(u), std::max(n - 2, 0));
+    frac = n > 1 ? u - i0 : 0.0;
+  };
+  int i, j, k;
+  double fx, fy, fz;
+  locate(x, f.origin.x, f.spacing.x, f.nx, i, fx);
+  locate(y, f.origin.y, f.spacing.y, f.ny, j, fy);
+  locate(z, f.origin.z, f.spacing.z, f.nz, k, fz);
+  double r[3] = {0, 0, 0};
+  for (int dk = 0; dk <= 1; ++dk) {
+    const double wz = dk ? fz : 1.0 - fz;
+    if (wz == 0.0) continue;
+    for (int dj = 0; dj <= 1; ++dj) {
+      const double wy = dj ? fy : 1.0 - fy;
+      if (wy == 0.0) continue;
+      for (int di = 0; di <= 1; ++di) {
+        const double w = wz * wy * (di ? fx : 1.0 - fx);
+        if (w == 0.0) continue;
+        const Vec3f& d = f.displacement[f.linear(i + di, j + dj, k + dk)];
+        r[0] += w * d.x;
+        r[1] += w * d.y;
+        r[2] += w * d.z;
+      }
+    }
+  }
+  return {static_cast<float>(r[0]), static_cast<float>(r[1]), static_cast<float>(r[2])};
+}
+
+void deform_pair(const VolumeView& a, const VolumeView& b, const VectorField& predictor, int factor,
+                 Interpolation interpolation, std::vector<float>& out_a, std::vector<float>& out_b, int threads) {
+  out_a.assign(a.count(), 0.0f);
+  out_b.assign(b.count(), 0.0f);
+  const double offset = 0.5 * (factor - 1);  // full-grid position of a binned voxel's centre
+  const float half = 0.5f / factor;           // half the displacement, in binned voxels
+#pragma omp parallel for num_threads(thread_count(threads)) schedule(dynamic, 1)
+  for (int k = 0; k < a.nz; ++k)
+    for (int j = 0; j < a.ny; ++j) {
+      const std::size_t row = a.linear(0, j, k);
+      for (int i = 0; i < a.nx; ++i) {
+        const Vec3f d = sample_field(predictor, i * factor + offset, j * factor + offset, k * factor + offset);
+        const float hx = d.x * half, hy = d.y * half, hz = d.z * half;
+        if (interpolation == Interpolation::trilinear) {
+          out_a[row + i] = sample_trilinear(a, i - hx, j - hy, k - hz);
+          out_b[row + i] = sample_trilinear(b, i + hx, j + hy, k + hz);
+        } else {
+          out_a[row + i] = sample_bspline(a, i - hx, j - hy, k - hz);
+          out_b[row + i] = sample_bspline(b, i + hx, j + hy, k + hz);
+        }
+      }
+    }
+}
+
+}  // namespace tomorig::piv::detail
