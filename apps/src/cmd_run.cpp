@@ -9,6 +9,8 @@
 #include <fmt/core.h>
 
 #include "commands.h"
+#include "stop_signal.h"
+#include "tomorig/trigger/rig_trigger.h"
 #include "simulate_session.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
@@ -63,6 +65,9 @@ void run(const RunOptions& opt) {
                                   out.parent_path().string(), ec.message()));
   }
 
+  // The trigger timing and the light sources' safety limits are checked before anything runs.
+  const trigger::TimingPlan plan = trigger::plan_and_check(trigger::rig_trigger(rig));
+  (void)plan;
   fmt::print("tomorig run: rig '{}', {} cameras, {} sets, case {} at {} ppp\n", rig.name, rig.cameras.size(),
              rig.simulation->sets, rig.simulation->case_name, rig.simulation->ppp);
   const auto started = std::chrono::steady_clock::now();
@@ -73,7 +78,13 @@ void run(const RunOptions& opt) {
                elapsed > 0 ? static_cast<double>(done) / elapsed : 0.0, eta);
     if (done == total) fmt::print(stderr, "\n");
   };
-  const SimulationSummary summary = run_simulation_to_session(rig, out, *compression, opt.overwrite, progress, /*live=*/true);
+  // Ctrl-C ends the recording between sets with a complete, valid file; a second Ctrl-C quits.
+  const StopSignalGuard stop;
+  const SimulationSummary summary = run_simulation_to_session(rig, out, *compression, opt.overwrite, progress,
+                                                              /*live=*/true, [&stop] { return stop.stop_requested(); });
+  if (stop.stop_requested())
+    fmt::print(stderr, "\nstopped by {} after {} of {} sets; the session is complete\n", stop.signal_name(),
+               summary.sets, rig.simulation->sets);
   fmt::print("{}\n", summary.brief());
   fmt::print("next: tomorig inspect {}\n", summary.output.string());
 }

@@ -111,7 +111,8 @@ sim::SimulationOptions simulation_options_from(const config::RigConfig& rig) {
 
 SimulationSummary run_simulation_to_session(const config::RigConfig& rig, const std::filesystem::path& out,
                                             storage::Compression compression, bool overwrite,
-                                            const SimulationProgress& progress, bool live) {
+                                            const SimulationProgress& progress, bool live,
+                                            const std::function<bool()>& should_stop) {
   const auto start = Clock::now();
   // Everything that can be wrong with the input is found here, before a file exists.
   const sim::SimulationOptions options = simulation_options_from(rig);
@@ -148,8 +149,10 @@ SimulationSummary run_simulation_to_session(const config::RigConfig& rig, const 
   auto render = [&simulated](int k) { return simulated.render_set(static_cast<std::uint64_t>(k)); };
   std::future<sim::SimulatedSet> next = std::async(std::launch::async, render, 0);
   auto previous_done = Clock::now();
+  int written = 0;
   for (int k = 0; k < sets; ++k) {
     sim::SimulatedSet set = next.get();
+    if (should_stop && should_stop()) break;  // the set rendered ahead is dropped, never half-written
     if (k + 1 < sets) next = std::async(std::launch::async, render, k + 1);
     writer.append(set.frames);
     storage::TruthSet truth_set;
@@ -158,12 +161,13 @@ SimulationSummary run_simulation_to_session(const config::RigConfig& rig, const 
     writer.write_truth_set(static_cast<std::uint64_t>(k), truth_set);
     if (progress) progress(static_cast<std::uint64_t>(k) + 1, static_cast<std::uint64_t>(sets), seconds_since(previous_done));
     previous_done = Clock::now();
+    written = k + 1;
   }
   writer.finish();
 
   SimulationSummary summary;
   summary.case_name = truth.case_name;
-  summary.sets = static_cast<std::uint64_t>(sets);
+  summary.sets = static_cast<std::uint64_t>(written);
   summary.cameras = simulated.cameras().size();
   summary.particles_per_set = simulated.particles_per_set();
   summary.output = out;

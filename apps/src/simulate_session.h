@@ -37,10 +37,13 @@ sim::SimulationOptions simulation_options_from(const config::RigConfig& rig);
 
 // Renders rig.simulation->sets sets and writes them, the rig's TOML text and the truth to
 // `out` through storage::SessionWriter. Everything is validated before the file is created.
+// `should_stop` (optional) is asked between sets; when it says true, the sets written so far are
+// finished into a complete session (summary.sets says how many).
 // `live`: record as a running rig does (storage::SessionWriterOptions::live): readable while
 // written, flushed as it goes, and an interrupted run keeps its sets in "<out>.partial".
 SimulationSummary run_simulation_to_session(const config::RigConfig& rig, const std::filesystem::path& out,
                                             storage::Compression compression, bool overwrite,
-                                            const SimulationProgress& progress = {}, bool live = false);
+                                            const SimulationProgress& progress = {}, bool live = false,
+                                            const std::function<bool()>& should_stop = {});
 
 }  // namespace tomorig::app

@@ -4,6 +4,9 @@
 #include <filesystem>
 #include <fstream>
 
+#include <csignal>
+
+#include "child_process.h"
 #include "cli_runner.h"
 #include "tomorig/storage/session_file.h"
 
@@ -55,6 +58,30 @@ TEST(RunCommand, UnwritableOutputIsBadInputAndLeavesNothingBehind) {
   int entries = 0;
   for ([[maybe_unused]] auto& e : std::filesystem::directory_iterator(tmp.path())) ++entries;
   EXPECT_EQ(entries, 1);  // only the plain file itself
+}
+
+}  // namespace
+}  // namespace tomorig::testing
+
+// Ctrl-C during `tomorig run` ends the recording between sets with a complete session.
+namespace tomorig::testing {
+namespace {
+
+TEST(RunCommandSignals, SigintLeavesACompleteSessionWithTheSetsRecorded) {
+  TempDir dir;
+  const auto out = dir / "run.h5";
+  TomorigProcess run({"run", "--sets", "500", "-o", out.string()});
+  ASSERT_TRUE(run.wait_for_line("recording: set 3/")) << run.err();
+  run.send_signal(SIGINT);
+  ASSERT_EQ(run.wait(), 0) << run.err();
+  EXPECT_NE(run.err().find("stopped by SIGINT"), std::string::npos) << run.err();
+  ASSERT_TRUE(std::filesystem::exists(out));
+  EXPECT_FALSE(std::filesystem::exists(out.string() + ".partial"));
+  const storage::SessionReader session(out);
+  EXPECT_TRUE(session.recording_complete());
+  EXPECT_GE(session.set_count(), 3u);
+  EXPECT_LT(session.set_count(), 500u);
+  EXPECT_EQ(session.truth_set_count(), session.set_count());
 }
 
 }  // namespace
