@@ -95,14 +95,9 @@ class MartReconstructor final : public Reconstructor {
           }
         }
       }
-      IterationStats stats;
-      stats.iteration = it;
-      stats.residual = measured_sum > 0 ? diff / measured_sum : 0.0;
-      stats.mean_update = updates > 0 ? update_sum / updates : 0.0;
-      stats.seconds = seconds_since(t0);
-      report.history.push_back(stats);
-      report.iterations = it;
-      if (options_.stop_mean_update > 0 && stats.mean_update < options_.stop_mean_update) break;
+      if (record_iteration(report, it, measured_sum > 0 ? diff / measured_sum : 0.0,
+                           updates > 0 ? update_sum / updates : 0.0, seconds_since(t0), options_.stop_mean_update))
+        break;
     }
     SparseVolume volume = to_volume(s.in.grid, s.set.index, e);
     finish_report(report, start, volume);

@@ -74,14 +74,9 @@ class MultiplicativeReconstructor final : public Reconstructor {
           update_sum += std::fabs(1.0f - factor);
         }
       }
-      IterationStats stats;
-      stats.iteration = it;
-      stats.residual = measured > 0 ? diff / measured : 0.0;
-      stats.mean_update = update_sum / updates;
-      stats.seconds = seconds_since(t0);
-      report.history.push_back(stats);
-      report.iterations = it;
-      if (options_.stop_mean_update > 0 && stats.mean_update < options_.stop_mean_update) break;
+      if (record_iteration(report, it, measured > 0 ? diff / measured : 0.0, update_sum / updates, seconds_since(t0),
+                           options_.stop_mean_update))
+        break;
     }
     SparseVolume volume = to_volume(s.in.grid, s.set.index, e);
     finish_report(report, start, volume);

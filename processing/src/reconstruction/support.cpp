@@ -88,6 +88,18 @@ SparseVolume to_volume(const VoxelGrid& grid, const std::vector<std::uint32_t>& 
   return v;
 }
 
+bool record_iteration(ReconstructionReport& report, int iteration, double residual, double mean_update,
+                      double seconds, double stop_mean_update) {
+  IterationStats stats;
+  stats.iteration = iteration;
+  stats.residual = residual;
+  stats.mean_update = mean_update;
+  stats.seconds = seconds;
+  report.history.push_back(stats);
+  report.iterations = iteration;
+  return stop_mean_update > 0 && mean_update < stop_mean_update;
+}
+
 void finish_report(ReconstructionReport& report, std::chrono::steady_clock::time_point start,
                    const SparseVolume& volume) {
   report.nonzero_voxels = volume.size();

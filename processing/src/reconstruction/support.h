@@ -34,6 +34,11 @@ Support build_support(const ReconstructionInput& input, const ReconstructionOpti
 SparseVolume to_volume(const VoxelGrid& grid, const std::vector<std::uint32_t>& index, const std::vector<float>& e);
 
 // Fills the totals of the report (time since `start`, peak RSS, non-zero voxels).
+// Appends the statistics of one iteration to the report; returns true when the mean update has
+// fallen below `stop_mean_update` (if > 0), i.e. when the iterations should stop.
+bool record_iteration(ReconstructionReport& report, int iteration, double residual, double mean_update,
+                      double seconds, double stop_mean_update);
+
 void finish_report(ReconstructionReport& report, std::chrono::steady_clock::time_point start,
                    const SparseVolume& volume);
 
