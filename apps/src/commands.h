@@ -16,6 +16,8 @@ void add_replay_command(CLI::App& root);   // cmd_replay.cpp
 void add_record_command(CLI::App& root);   // cmd_record.cpp
 void add_trigger_command(CLI::App& root);   // cmd_trigger.cpp: trigger plan
 void add_reconstruct_command(CLI::App& root);  // cmd_reconstruct.cpp
+void add_calibrate_command(CLI::App& root);  // cmd_calibrate.cpp
+void add_preprocess_command(CLI::App& root);  // cmd_preprocess.cpp
 void add_bench_command(CLI::App& root);     // cmd_bench.cpp: bench stream | record | recon
 
 }  // namespace tomorig::app

@@ -24,7 +24,9 @@ int main(int argc, char** argv) {
   add_simulate_command(app);
   add_import_command(app);
   add_inspect_command(app);
+  add_calibrate_command(app);
   add_reconstruct_command(app);
+  add_preprocess_command(app);
   add_config_command(app);
   add_bench_command(app);
   add_trigger_command(app);

@@ -84,7 +84,7 @@ TEST_P(RoundTrip, EverythingReadsBackBitIdentical) {
   written[2].cameras[0].b.image = Image();
   const SessionTruth truth = test_truth();
   {
-    SessionWriter writer(path, info, {compression, false});
+    SessionWriter writer(path, info, testing::writer_options(compression));
     for (const auto& set : written) writer.append(set);
     writer.write_truth_set(1, test_truth_set(50, 1.0));
     writer.write_truth(truth);
@@ -187,7 +187,7 @@ TEST(SessionWriter, BitshuffleFilterIsOnTheFramesAndShrinksSmoothImages) {
     const fs::path path = dir / (std::string(to_string(c)) + ".h5");
     SessionInfo info;
     info.cameras = cameras;
-    SessionWriter writer(path, info, {c, false});
+    SessionWriter writer(path, info, testing::writer_options(c));
     for (std::uint64_t s = 0; s < 8; ++s) writer.append(smooth_set(s));
     writer.finish();
   }
@@ -312,7 +312,7 @@ TEST(SessionWriter, OverwriteReplacesAnExistingSession) {
   const fs::path path = dir / "s.h5";
   const std::vector<SessionCamera> cameras{test_camera("cam0", 8, 8, PixelFormat::Mono8)};
   testing::write_test_session(path, cameras, 1);
-  testing::write_test_session(path, cameras, 3, {Compression::none, true});
+  testing::write_test_session(path, cameras, 3, testing::writer_options(Compression::none, true));
   EXPECT_EQ(SessionReader(path).set_count(), 3u);
 }
 
@@ -322,7 +322,7 @@ TEST(SessionSummary, ReportsTimingAndTruth) {
   SessionInfo info;
   info.cameras = cameras;
   {
-    SessionWriter writer(dir / "s.h5", info, {Compression::bitshuffle_lz4, false});
+    SessionWriter writer(dir / "s.h5", info, testing::writer_options(Compression::bitshuffle_lz4));
     for (std::uint64_t s = 0; s < 5; ++s) writer.append(test_set(cameras, s));
     writer.write_truth(test_truth());
     writer.write_truth_set(0, test_truth_set(3, 0));

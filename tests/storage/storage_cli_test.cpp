@@ -45,7 +45,7 @@ TEST_F(CliTest, InspectJsonDescribesTheSession) {
   SessionInfo info;
   info.cameras = cameras;
   {
-    SessionWriter writer(path, info, {Compression::bitshuffle_lz4, false});
+    SessionWriter writer(path, info, testing::writer_options(Compression::bitshuffle_lz4));
     for (std::uint64_t s = 0; s < 3; ++s) {
       FrameSet set = test_set(cameras, s);
       if (s == 1) set.cameras[0].a.image = Image();

@@ -43,6 +43,15 @@ inline SessionCamera test_camera(const std::string& id, int width, int height, P
   return c;
 }
 
+// Writer options without spelling out every field (aggregate initialisation would warn about
+// the ones left out).
+inline SessionWriterOptions writer_options(Compression compression, bool overwrite = false) {
+  SessionWriterOptions o;
+  o.compression = compression;
+  o.overwrite = overwrite;
+  return o;
+}
+
 // A full set for `cameras`, every frame present.
 inline FrameSet test_set(const std::vector<SessionCamera>& cameras, std::uint64_t index) {
   FrameSet set;

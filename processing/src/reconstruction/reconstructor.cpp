@@ -5,6 +5,7 @@
 #include <fmt/core.h>
 
 #include "algorithms.h"
+#include "ment.h"
 #include "tomorig/core/error.h"
 
 namespace tomorig::recon {
@@ -33,7 +34,7 @@ void ReconstructionOptions::validate() const {
     throw bad_input(fmt::format("reconstruction: memory_limit_mb = {} must be >= 0 (0: MemAvailable)", memory_limit_mb));
 }
 
-std::string algorithm_names() { return "mlos, mart, smart, fmart"; }
+std::string algorithm_names() { return "mlos, ment, mart, smart, fmart"; }
 
 std::unique_ptr<Reconstructor> make_reconstructor(const ReconstructionOptions& options) {
   options.validate();
@@ -42,8 +43,7 @@ std::unique_ptr<Reconstructor> make_reconstructor(const ReconstructionOptions& o
   if (a == "mart") return detail::make_mart(options);
   if (a == "smart") return detail::make_smart(options);
   if (a == "fmart") return detail::make_fmart(options);
-  if (a == "ment")
-    throw bad_input("reconstruction: algorithm 'ment' is not available yet; use one of: " + algorithm_names());
+  if (a == "ment") return detail::make_ment(options);
   throw bad_input(fmt::format("reconstruction: unknown algorithm '{}'; use one of: {}", a, algorithm_names()));
 }
 

@@ -114,12 +114,7 @@ TEST(ReconstructionErrors, BadOptionsAndAlgorithms) {
   EXPECT_THROW(recon::make_reconstructor(o), Error);
   o = {};
   o.algorithm = "ment";
-  try {
-    recon::make_reconstructor(o);
-    ADD_FAILURE() << "ment accepted";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("not available yet"), std::string::npos);
-  }
+  EXPECT_NO_THROW(recon::make_reconstructor(o));
   o.algorithm = "art";
   EXPECT_THROW(recon::make_reconstructor(o), Error);
   EXPECT_NO_THROW(recon::ReconstructionOptions{}.validate());  // the defaults are valid

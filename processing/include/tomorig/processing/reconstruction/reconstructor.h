@@ -6,7 +6,7 @@
 //   "smart" simultaneous MART with MLOS initialisation and relaxation mu (Eq. 3.5)
 //   "fmart" fast MART: sparse MLOS support, precomputed image positions, LUT weights,
 //           per-camera projection then multiplicative update (Eq. 3.9)
-//   ("ment", Sect. 3.1.1, is planned behind the same interface.)
+//   "ment"  maximum entropy technique: pseudo-images, volume as their product, streamed by z-slice (Sect. 3.1.1)
 //
 //   recon::ReconstructionOptions opt;  opt.algorithm = "fmart";
 //   auto r = recon::make_reconstructor(opt);   // throws bad_input for a bad option
@@ -46,7 +46,7 @@ struct ReconstructionInput {
 };
 
 struct ReconstructionOptions {
-  // "mlos", "mart", "smart" or "fmart".
+  // "mlos", "ment", "mart", "smart" or "fmart".
   std::string algorithm = "fmart";
   // Iterations of MART/SMART/FMART (MLOS ignores it). FMART needs 4-8 (thesis Fig. 3.5).
   int max_iterations = 8;

@@ -1,0 +1,193 @@
+// tomorig preprocess: a session -> a preprocessed session (same layout, Mono16 frames), so a
+// preprocessing chain can be checked by eye (tomorig inspect --png) before a long run.
+//
+// Steps that need a sequence statistic (subtract_minimum, normalize by average_image) get it
+// from an earlier streaming pass over the selected sets, one pass per such step, per camera
+// and exposure; the last pass writes the output. Float results are rounded and clipped to
+// [0, 65535] (docs/preprocessing.md).
+#include <array>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+
+#include "commands.h"
+#include "tomorig/core/error.h"
+#include "tomorig/processing/preprocess/chain_spec.h"
+#include "tomorig/processing/preprocess/image_chain.h"
+#include "tomorig/processing/preprocess/sequence_image.h"
+#include "tomorig/storage/session_file.h"
+
+namespace tomorig::app {
+namespace {
+
+namespace fs = std::filesystem;
+using preprocess::ImageChain;
+
+struct PreprocessArgs {
+  std::string session;
+  std::string chain;
+  std::string out;
+  std::string sets;
+  bool overwrite = false;
+};
+
+struct SetRange {
+  std::uint64_t first = 0;
+  std::uint64_t end = 0;  // one past the last
+};
+
+// "A:B" is the half-open range [A, B); "A:" runs to the end; empty means every set.
+SetRange parse_sets(const std::string& text, std::uint64_t count) {
+  if (text.empty()) return {0, count};
+  const auto colon = text.find(':');
+  const auto fail = [&](const std::string& why) {
+    throw bad_input(fmt::format("--sets '{}': {}; write A:B for sets A to B-1 (0-based), or A: for A to the end; the "
+                                "session has {} sets", text, why, count));
+  };
+  if (colon == std::string::npos) fail("missing ':'");
+  const auto number = [&](const std::string& part, std::uint64_t fallback) -> std::uint64_t {
+    if (part.empty()) return fallback;
+    if (part.find_first_not_of("0123456789") != std::string::npos || part.size() > 18) fail("'" + part + "' is not a set number");
+    return std::stoull(part);
+  };
+  SetRange range{number(text.substr(0, colon), 0), number(text.substr(colon + 1), count)};
+  if (range.end > count) fail("the end is past the last set");
+  if (range.first >= range.end) fail("the range is empty");
+  return range;
+}
+
+// The average of every present frame of `camera_id` in a session of reference frames (darks or
+// bright fields).
+Image reference_image(const fs::path& file, const std::string& camera_id, std::size_t step) {
+  const auto reader = [&] {
+    try {
+      return std::make_unique<storage::SessionReader>(file);
+    } catch (const Error& e) {
+      throw Error(e.kind(), fmt::format("preprocess step {}: reference frames: {}", step, e.what()));
+    }
+  };
+  const std::unique_ptr<storage::SessionReader> opened = reader();
+  const storage::SessionReader& reference = *opened;
+  preprocess::MeanImage mean;
+  for (std::uint64_t s = 0; s < reference.set_count(); ++s) {
+    const FrameSet set = reference.read_set(s);
+    for (const CameraFrames& c : set.cameras) {
+      if (c.camera_id != camera_id) continue;
+      for (const Frame* f : {&c.a, &c.b})
+        if (f->present()) mean.add(f->image);
+    }
+  }
+  if (mean.count() == 0)
+    throw bad_input(fmt::format("preprocess step {}: reference session '{}' has no frame of camera '{}'", step,
+                                file.string(), camera_id));
+  return mean.result();
+}
+
+// A relative reference path in the chain file is relative to the chain file's folder.
+fs::path resolve(const std::string& file, const fs::path& chain_path) {
+  const fs::path p(file);
+  return p.is_absolute() ? p : chain_path.parent_path() / p;
+}
+
+void run(const PreprocessArgs& args) {
+  const preprocess::ChainSpec spec = preprocess::read_chain_file(args.chain);
+  const storage::SessionReader session(args.session);
+  const SetRange range = parse_sets(args.sets, session.set_count());
+  const auto& cameras = session.info().cameras;
+
+  std::vector<ImageChain> chains;
+  for (const auto& camera : cameras) {
+    chains.emplace_back(spec);
+    for (std::size_t i = 0; i < spec.steps.size(); ++i)
+      if (preprocess::needs_reference_image(spec.steps[i]))
+        chains.back().set_reference_image(i, reference_image(resolve(spec.steps[i].file, args.chain), camera.id, i));
+  }
+
+  std::vector<std::size_t> sequence_steps;
+  for (std::size_t i = 0; i < spec.steps.size(); ++i)
+    if (preprocess::needs_sequence_image(spec.steps[i])) sequence_steps.push_back(i);
+  const std::size_t passes = sequence_steps.size() + 1;
+  const std::uint64_t set_total = range.end - range.first;
+  const auto progress = [&](std::size_t pass, std::uint64_t done) {
+    fmt::print(stderr, "\rpreprocess: pass {}/{}, set {}/{}", pass + 1, passes, done, set_total);
+    if (done == set_total) fmt::print(stderr, "\n");
+  };
+
+  // Streaming passes: the chain up to each sequence step, folded into a minimum or an average.
+  for (std::size_t p = 0; p < sequence_steps.size(); ++p) {
+    const std::size_t step = sequence_steps[p];
+    const bool minimum = spec.steps[step].kind == preprocess::StepKind::subtract_minimum;
+    std::vector<std::array<preprocess::MinimumImage, 2>> minima(cameras.size());
+    std::vector<std::array<preprocess::MeanImage, 2>> means(cameras.size());
+    for (std::uint64_t s = range.first; s < range.end; ++s) {
+      const FrameSet set = session.read_set(s);
+      for (std::size_t c = 0; c < set.cameras.size() && c < chains.size(); ++c)
+        for (const Exposure e : {Exposure::A, Exposure::B}) {
+          const Frame& frame = set.cameras[c][e];
+          if (!frame.present()) continue;
+          const Image& partial = chains[c].run(frame.image, e, step);
+          if (minimum) minima[c][static_cast<int>(e)].add(partial);
+          else means[c][static_cast<int>(e)].add(partial);
+        }
+      progress(p, s - range.first + 1);
+    }
+    for (std::size_t c = 0; c < chains.size(); ++c)
+      for (const Exposure e : {Exposure::A, Exposure::B}) {
+        const int k = static_cast<int>(e);
+        if ((minimum ? minima[c][k].count() : means[c][k].count()) == 0)
+          throw bad_input(fmt::format("camera '{}' has no frame {} in the selected sets, so step {} ({}) has no "
+                                      "sequence image; select more sets", cameras[c].id, k == 0 ? "A" : "B", step,
+                                      to_string(spec.steps[step].kind)));
+        chains[c].set_sequence_image(step, e, minimum ? minima[c][k].result() : means[c][k].result());
+      }
+  }
+
+  storage::SessionInfo info = session.info();
+  info.software_version.clear();
+  info.created_utc.clear();
+  for (auto& camera : info.cameras) camera.pixel_format = PixelFormat::Mono16;
+  storage::SessionWriterOptions options;
+  options.compression = session.info().compression;
+  options.overwrite = args.overwrite;
+  storage::SessionWriter writer(args.out, info, options);
+  if (session.has_truth()) writer.write_truth(session.truth());
+
+  for (std::uint64_t s = range.first; s < range.end; ++s) {
+    FrameSet set = session.read_set(s);
+    for (std::size_t c = 0; c < set.cameras.size() && c < chains.size(); ++c)
+      for (const Exposure e : {Exposure::A, Exposure::B}) {
+        Frame& frame = set.cameras[c][e];
+        if (!frame.present()) continue;
+        Image out;  // a fresh image: the FrameSet keeps it until append() has written it
+        preprocess::to_uint16(chains[c].run(frame.image, e), out);
+        frame.image = out;
+      }
+    writer.append(set);
+    if (session.has_truth_set(s)) writer.write_truth_set(s - range.first, session.truth_set(s));
+    progress(passes - 1, s - range.first + 1);
+  }
+  writer.finish();
+  fmt::print("wrote {} sets of {} cameras to {} ({} steps)\n", set_total, cameras.size(), args.out, spec.steps.size());
+}
+
+}  // namespace
+
+void add_preprocess_command(CLI::App& root) {
+  auto args = std::make_shared<PreprocessArgs>();
+  CLI::App* cmd = root.add_subcommand(
+      "preprocess", "Apply an image preprocessing chain (TOML) to a session and write a preprocessed session");
+  cmd->add_option("--session", args->session, "Session file to read (.h5)")->required();
+  cmd->add_option("--chain", args->chain, "Preprocessing chain ([[preprocess.steps]] TOML, docs/preprocessing.md)")
+      ->required();
+  cmd->add_option("-o,--out", args->out, "Preprocessed session to write (.h5)")->required();
+  cmd->add_option("--sets", args->sets, "Sets A:B (A to B-1, 0-based) or A: (to the end); default all");
+  cmd->add_flag("--overwrite", args->overwrite, "Replace an existing output file");
+  cmd->callback([args] { run(*args); });
+}
+
+}  // namespace tomorig::app

@@ -1,0 +1,61 @@
+#pragma once
+// The description of an image preprocessing chain: an ordered list of steps with their
+// parameters, read from TOML (docs/preprocessing.md). The spec is plain data; ImageChain
+// (image_chain.h) runs it on frames.
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace tomorig::preprocess {
+
+enum class StepKind {
+  subtract_dark,           // I - D (a dark image per camera, or a constant level)
+  subtract_minimum,        // I - min over the sequence (per camera and exposure)
+  subtract_local_minimum,  // I - min over a sliding size x size window
+  median,                  // median over size x size (3 or 5)
+  lowpass,                 // Gaussian low-pass, sigma in pixels
+  highpass,                // I - Gaussian low-pass, clipped at 0
+  normalize,               // I / mean(I) * target, or I / average image * target
+  flat_field,              // I / B * mean(B), B a bright-field image per camera
+  invert,                  // max - I (shadowgraphs), clipped at 0
+  clip,                    // values below a threshold (constant, or median + k robust sigma) set to 0
+};
+
+enum class NormalizeBy { mean, average_image };
+
+struct Step {
+  StepKind kind = StepKind::median;
+  int size = 3;               // subtract_local_minimum, median
+  double sigma = 1.0;         // lowpass, highpass
+  NormalizeBy by = NormalizeBy::mean;
+  double target = 1000.0;     // normalize: the mean (or average-image level) maps to this
+  std::string file;           // subtract_dark, flat_field: session file of reference frames
+  double level = 0.0;         // subtract_dark (constant dark), clip (constant threshold)
+  bool use_sigmas = false;    // clip: threshold = background mean + sigmas * background sigma
+  double sigmas = 3.0;
+  bool subtract = false;      // clip: also subtract the threshold from what is kept
+  double max = 65535.0;       // invert
+};
+
+struct ChainSpec {
+  std::vector<Step> steps;
+};
+
+std::string_view to_string(StepKind kind);
+
+// Steps whose parameters come from a first pass over the whole sequence.
+bool needs_sequence_image(const Step& step);
+// Steps that need a reference image per camera (dark or bright field) from `file`.
+bool needs_reference_image(const Step& step);
+
+// Checks one step's parameters; bad_input naming "step <index> (<kind>): <parameter>".
+void validate(const Step& step, std::size_t index);
+
+// Parses `[[preprocess.steps]]` tables. Errors are bad_input naming `source`, the key path
+// (preprocess.steps[i].key), its line and what is allowed; unknown keys are errors.
+ChainSpec parse_chain(std::string_view toml_text, const std::string& source);
+ChainSpec read_chain_file(const std::filesystem::path& path);
+
+}  // namespace tomorig::preprocess
