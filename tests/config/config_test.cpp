@@ -1,6 +1,7 @@
 // The rig config parser: the embedded default, and every class of problem it reports, each
 // named by key path and line.
 #include "temp_dir.h"
+#include "config_test_support.h"
 #include "tomorig/config/rig_config.h"
 
 #include <gtest/gtest.h>
@@ -19,6 +20,8 @@
 
 namespace tomorig::config {
 namespace {
+using test_support::dump;
+using test_support::line_containing;
 
 // ---- helpers ------------------------------------------------------------------------------
 
@@ -32,27 +35,12 @@ std::string rig_with(const std::string& camera_extra = "", const std::string& ta
          camera_extra + "\n[cameras.roi]\n" + roi + "\n" + tail;
 }
 
-// 1-based line of the first line containing `needle`: tests say where a problem is by its
-// text, so editing a fixture cannot silently shift what they expect.
-int line_containing(const std::string& doc, const std::string& needle) {
-  std::istringstream in(doc);
-  std::string line;
-  for (int n = 1; std::getline(in, line); ++n)
-    if (line.find(needle) != std::string::npos) return n;
-  ADD_FAILURE() << "fixture has no line containing " << needle;
-  return -1;
-}
 
 const ConfigIssue* find_issue(const std::vector<ConfigIssue>& issues, const std::string& key) {
   auto it = std::find_if(issues.begin(), issues.end(), [&](const ConfigIssue& i) { return i.key == key; });
   return it == issues.end() ? nullptr : &*it;
 }
 
-std::string dump(const std::vector<ConfigIssue>& issues) {
-  std::string out;
-  for (const auto& i : issues) out += "  " + i.to_string() + "\n";
-  return out.empty() ? "  (no issues)\n" : out;
-}
 
 // Expects an issue for `key` on the line holding `at` (a fragment of the fixture) whose
 // message contains `text`.

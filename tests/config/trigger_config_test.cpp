@@ -8,10 +8,13 @@
 #include <string>
 #include <vector>
 
+#include "config_test_support.h"
 #include "tomorig/config/rig_config.h"
 
 namespace tomorig::config {
 namespace {
+using test_support::dump;
+using test_support::line_containing;
 
 // One simulated camera, then `trigger` (the [trigger] table and its sub-tables).
 std::string rig_with_trigger(const std::string& trigger) {
@@ -20,20 +23,7 @@ std::string rig_with_trigger(const std::string& trigger) {
 
 const std::string kSim = "[trigger]\nbackend = \"simulated\"\n";
 
-int line_containing(const std::string& doc, const std::string& needle) {
-  std::istringstream in(doc);
-  std::string line;
-  for (int n = 1; std::getline(in, line); ++n)
-    if (line.find(needle) != std::string::npos) return n;
-  ADD_FAILURE() << "fixture has no line containing " << needle;
-  return -1;
-}
 
-std::string dump(const std::vector<ConfigIssue>& issues) {
-  std::string out;
-  for (const auto& i : issues) out += "  " + i.to_string() + "\n";
-  return out.empty() ? "  (no issues)\n" : out;
-}
 
 // Expects an issue for `key` on the line holding `at` whose message contains `text`.
 void expect_issue(const std::string& doc, const std::string& key, const std::string& at, const std::string& text) {
