@@ -248,8 +248,19 @@ void VolumeFileWriter::finish() {
     throw runtime_error(fmt::format("closing volume file '{}' failed, so it may be incomplete (is the disk full?): {}",
                                     m.partial.path().string(), h5::error_stack_text()));
 
-  // The sidecar goes into place first: a volume file under its final name always has one.
+  // The sidecar goes into place first: a volume file with dense data under its final name always
+  // has one. Without dense data (sparse only) there is nothing for ParaView to show, so none.
   const fs::path sidecar = sidecar_path(m.final_path);
+  std::error_code ec;
+  if (m.xdmf.empty()) {
+    fs::remove(sidecar, ec);  // an old sidecar (overwrite) would point at data that is gone
+    fs::rename(m.partial.path(), m.final_path, ec);
+    if (ec) throw runtime_error(fmt::format("cannot rename '{}' to '{}': {}", m.partial.path().string(),
+                                            m.final_path.string(), ec.message()));
+    m.partial.release();
+    m.finished = true;
+    return;
+  }
   PartialFile sidecar_partial(fs::path(sidecar).concat(".partial"));
   {
     std::ofstream out(sidecar_partial.path(), std::ios::binary | std::ios::trunc);
@@ -259,7 +270,6 @@ void VolumeFileWriter::finish() {
     if (!out)
       throw runtime_error(fmt::format("cannot write XDMF file '{}' (is the disk full?)", sidecar_partial.path().string()));
   }
-  std::error_code ec;
   fs::rename(sidecar_partial.path(), sidecar, ec);
   if (ec) throw runtime_error(fmt::format("cannot rename '{}' to '{}': {}", sidecar_partial.path().string(),
                                           sidecar.string(), ec.message()));

@@ -138,6 +138,17 @@ TEST(VolumeFile, EmptySparseVolumeRoundTrips) {
             static_cast<std::ptrdiff_t>(kGrid.voxel_count()));
 }
 
+TEST(VolumeFile, SparseOnlyFileHasNoSidecar) {
+  TempDir dir;
+  VolumeFileWriter out(dir / "s.h5", {}, {.dense_export = false});
+  out.add("a", test_sparse(kGrid, 11), {});
+  out.finish();
+  EXPECT_FALSE(fs::exists(dir / "s.xdmf"));
+  VolumeFileReader in(dir / "s.h5");
+  EXPECT_FALSE(in.volume("a").has_dense);
+  EXPECT_EQ(in.read_sparse("a").index, test_sparse(kGrid, 11).index);
+}
+
 TEST(VolumeFile, AbandonedWriterLeavesNothing) {
   TempDir dir;
   { VolumeFileWriter out(dir / "v.h5", {}); out.add("a", test_sparse(kGrid, 4), {}); }

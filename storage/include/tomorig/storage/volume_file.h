@@ -50,7 +50,8 @@ class VolumeFileWriter {
   // `name` becomes /volumes/<name>; letters, digits, '_', '-' and '.' only; unique.
   void add(const std::string& name, const SparseVolume& volume, const VolumeAttributes& attributes);
   void add(const std::string& name, const DenseVolume& volume, const VolumeAttributes& attributes);
-  // Closes the file, writes the XDMF sidecar (<stem>.xdmf) and renames both into place.
+  // Closes the file, writes the XDMF sidecar (<stem>.xdmf) if any volume has dense data, and
+  // renames both into place.
   void finish();
 
   static std::filesystem::path sidecar_path(const std::filesystem::path& volume_file);
