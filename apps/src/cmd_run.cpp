@@ -66,8 +66,7 @@ void run(const RunOptions& opt) {
   }
 
   // The trigger timing and the light sources' safety limits are checked before anything runs.
-  const trigger::TimingPlan plan = trigger::plan_and_check(trigger::rig_trigger(rig));
-  (void)plan;
+  trigger::plan_and_check(trigger::rig_trigger(rig));
   fmt::print("tomorig run: rig '{}', {} cameras, {} sets, case {} at {} ppp\n", rig.name, rig.cameras.size(),
              rig.simulation->sets, rig.simulation->case_name, rig.simulation->ppp);
   const auto started = std::chrono::steady_clock::now();

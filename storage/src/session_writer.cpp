@@ -290,9 +290,9 @@ void SessionWriter::Impl::collect(const FrameSet& set) {
 void SessionWriter::Impl::write_collected(const FrameSet& set) {
   const hsize_t index = sets;
   const hsize_t n = sets + 1;
-  for (CameraStream& s : streams) {
+  for (std::size_t c = 0; c < streams.size(); ++c) {
+    CameraStream& s = streams[c];
     s.frames.grow_to(n);
-    const std::size_t c = static_cast<std::size_t>(&s - streams.data());
     for (hsize_t e = 0; e < 2; ++e) {
       const Frame* frame = frames_[2 * c + e];
       if (frame == nullptr) continue;  // missing: its chunk is never allocated (reads as 0)

@@ -254,26 +254,22 @@ void VolumeFileWriter::finish() {
   std::error_code ec;
   if (m.xdmf.empty()) {
     fs::remove(sidecar, ec);  // an old sidecar (overwrite) would point at data that is gone
-    fs::rename(m.partial.path(), m.final_path, ec);
-    if (ec) throw runtime_error(fmt::format("cannot rename '{}' to '{}': {}", m.partial.path().string(),
-                                            m.final_path.string(), ec.message()));
-    m.partial.release();
-    m.finished = true;
-    return;
+  } else {
+    PartialFile sidecar_partial(fs::path(sidecar).concat(".partial"));
+    {
+      std::ofstream out(sidecar_partial.path(), std::ios::binary | std::ios::trunc);
+      sidecar_partial.arm();
+      out << xdmf_for_volumes(m.xdmf);
+      out.close();
+      if (!out)
+        throw runtime_error(
+            fmt::format("cannot write XDMF file '{}' (is the disk full?)", sidecar_partial.path().string()));
+    }
+    fs::rename(sidecar_partial.path(), sidecar, ec);
+    if (ec) throw runtime_error(fmt::format("cannot rename '{}' to '{}': {}", sidecar_partial.path().string(),
+                                            sidecar.string(), ec.message()));
+    sidecar_partial.release();
   }
-  PartialFile sidecar_partial(fs::path(sidecar).concat(".partial"));
-  {
-    std::ofstream out(sidecar_partial.path(), std::ios::binary | std::ios::trunc);
-    sidecar_partial.arm();
-    out << xdmf_for_volumes(m.xdmf);
-    out.close();
-    if (!out)
-      throw runtime_error(fmt::format("cannot write XDMF file '{}' (is the disk full?)", sidecar_partial.path().string()));
-  }
-  fs::rename(sidecar_partial.path(), sidecar, ec);
-  if (ec) throw runtime_error(fmt::format("cannot rename '{}' to '{}': {}", sidecar_partial.path().string(),
-                                          sidecar.string(), ec.message()));
-  sidecar_partial.release();
   fs::rename(m.partial.path(), m.final_path, ec);
   if (ec) throw runtime_error(fmt::format("cannot rename '{}' to '{}': {}", m.partial.path().string(),
                                           m.final_path.string(), ec.message()));
