@@ -8,8 +8,8 @@
 
 namespace tomorig::acquisition {
 
-SimulatedCamera::SimulatedCamera(std::string id, FrameRenderer renderer)
-    : id_(std::move(id)), renderer_(std::move(renderer)) {
+SimulatedCamera::SimulatedCamera(std::string id, FrameRenderer renderer, SimulatedCameraFaults faults)
+    : id_(std::move(id)), renderer_(std::move(renderer)), faults_(faults) {
   if (id_.empty()) throw bad_input("simulated camera: the camera id is empty");
   if (!renderer_) throw bad_input(fmt::format("simulated camera {}: no frame renderer given", id_));
 }
@@ -45,6 +45,11 @@ StreamStatistics SimulatedCamera::statistics() const {
   return stats_;
 }
 
+bool SimulatedCamera::connected() const {
+  std::lock_guard lock(mutex_);
+  return !vanished_;
+}
+
 void SimulatedCamera::trigger(const TriggerInput& event) {
   // The whole trigger runs under the lock so stop() never races a delivery in progress:
   // after stop() returns, the sink is not called again.
@@ -53,6 +58,9 @@ void SimulatedCamera::trigger(const TriggerInput& event) {
     ++stats_.underruns;  // a trigger the camera was not ready for: its frames never exist
     return;
   }
+  if (faults_.vanish_after_events && events_delivered_ >= *faults_.vanish_after_events) vanished_ = true;
+  if (vanished_) return;  // a camera that is gone sends nothing; the assembler counts the loss
+  ++events_delivered_;
   RenderedPair pair = renderer_(id_, event);
   const int want_w = config_.roi.width, want_h = config_.roi.height;
   for (const Image* image : {&pair.a, &pair.b}) {

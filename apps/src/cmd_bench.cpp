@@ -9,6 +9,9 @@ namespace tomorig::app {
 void add_bench_stream_command(CLI::App& bench);  // bench_stream.cpp
 void add_bench_record_command(CLI::App& bench);  // bench_record.cpp
 void add_bench_recon_command(CLI::App& bench);   // bench_recon.cpp
+void add_bench_piv3d_command(CLI::App& bench);   // bench_piv3d.cpp
+void add_bench_recon_race_command(CLI::App& bench);  // bench_recon_race.cpp
+void add_bench_calib_command(CLI::App& bench);   // bench_calib.cpp
 
 void add_bench_command(CLI::App& root) {
   CLI::App* bench = root.add_subcommand("bench", "Measure speed and accuracy on simulated cases; print JSON");
@@ -16,6 +19,9 @@ void add_bench_command(CLI::App& root) {
   add_bench_stream_command(*bench);
   add_bench_record_command(*bench);
   add_bench_recon_command(*bench);
+  add_bench_piv3d_command(*bench);
+  add_bench_recon_race_command(*bench);
+  add_bench_calib_command(*bench);
 }
 
 }  // namespace tomorig::app

@@ -1,8 +1,13 @@
-// tomorig calibrate --points POINTS.csv: fits camera models to point correspondences made
-// elsewhere, writes the calibration file and prints the residual report of thesis Tables 5.3
-// and 6.4 (per camera and model: forward residual in px, reverse residual in um).
+// tomorig calibrate: fits camera models to point correspondences, either made elsewhere
+// (--points POINTS.csv) or detected here in target images (--images DIR, --image-list CSV or
+// --session S.h5, with a target spec), optionally corrects traverse errors of the target
+// planes (--stage-correction, thesis Sect. 6.3.3), writes the calibration file and prints the residual report of thesis
+// Tables 5.3 and 6.4 (per camera and model, and per plane: forward residual in px, reverse
+// residual in um).
 #include <algorithm>
 #include <charconv>
+#include <cmath>
+#include <cstdio>
 #include <map>
 #include <memory>
 #include <optional>
@@ -15,17 +20,34 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "calibrate_images.h"
+#include "calibrate_report.h"
 #include "commands.h"
 #include "correspondence_csv.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/calibration/calibration_file.h"
 #include "tomorig/processing/calibration/fit_camera_model.h"
+#include "tomorig/processing/calibration/traverse_correction.h"
 
 namespace tomorig::app {
 namespace {
 
 struct CalibrateArgs {
   std::string points;
+  std::string images;
+  std::string image_list;
+  std::string session;
+  std::string z_list;
+  bool stage_correction = false;
+  std::string points_out;
+  // Target spec (with --images / --image-list).
+  std::string target = "dots";
+  double spacing_mm = 0;
+  std::string dots = "white";
+  std::string y_axis = "auto";
+  std::string corners;
+  double max_feature_px = 0;
+  int min_points_per_plane = 8;
   std::string models = "pinhole";
   std::string store;  // empty: the last of --models
   std::string image_size;
@@ -33,11 +55,6 @@ struct CalibrateArgs {
   int max_iterations = calibration::FitOptions{}.max_iterations;
   std::string out;
   bool json = false;
-};
-
-struct ModelResult {
-  int camera = 0;
-  calibration::FitReport report;
 };
 
 std::vector<std::string> split_list(const std::string& text) {
@@ -112,13 +129,99 @@ std::vector<calibration::ImageSize> image_sizes(const CalibrateArgs& args, std::
   return sizes;
 }
 
-void print_table(const std::vector<ModelResult>& results, const std::string& stored, const std::string& out) {
-  fmt::print("{:>6}  {:<10} {:>7} {:>7} {:>12} {:>12} {:>10}\n", "camera", "model", "points", "planes", "forward px",
-             "reverse um", "converged");
-  for (const ModelResult& r : results)
-    fmt::print("{:>6}  {:<10} {:>7} {:>7} {:>12.4g} {:>12.4g} {:>10}\n", r.camera, r.report.model, r.report.points,
-               r.report.planes, r.report.forward_mean_px, r.report.reverse_mean_um, r.report.converged ? "yes" : "no");
-  fmt::print("wrote {} (model {} for every camera)\n", out, stored);
+// The target spec from the command line.
+calibration::TargetSpec target_spec(const CalibrateArgs& args) {
+  if (!(args.spacing_mm > 0))
+    throw bad_input(fmt::format("--spacing {} is invalid: give the target's dot spacing or chessboard square size in mm "
+                                "(> 0), e.g. --spacing 3",
+                                args.spacing_mm));
+  if (args.target == "dots") {
+    calibration::DotGridSpec spec;
+    spec.spacing_mm = args.spacing_mm;
+    if (args.dots != "white" && args.dots != "black")
+      throw bad_input(fmt::format("--dots '{}' is invalid: white (white dots on black) or black", args.dots));
+    spec.white_dots = args.dots == "white";
+    if (args.y_axis != "auto" && args.y_axis != "down" && args.y_axis != "up")
+      throw bad_input(fmt::format("--y-axis '{}' is invalid: auto, down or up (the image direction of world +y)", args.y_axis));
+    spec.y_down = args.y_axis != "up";  // auto: detected with y down, flipped afterwards if need be
+    if (!(args.max_feature_px >= 0))
+      throw bad_input(fmt::format("--max-feature-px {} is invalid: it must be >= 0 (0 = automatic)", args.max_feature_px));
+    spec.max_feature_px = args.max_feature_px;
+    return spec;
+  }
+  if (args.target == "chessboard") {
+    calibration::ChessboardSpec spec;
+    const auto parts = split_list(args.corners);
+    if (parts.size() != 2 || !parse_int(parts[0], spec.inner_corners_x) || !parse_int(parts[1], spec.inner_corners_y) ||
+        spec.inner_corners_x < 2 || spec.inner_corners_y < 2)
+      throw bad_input(fmt::format("--corners '{}' is invalid: a chessboard target needs its inner corners NX,NY "
+                                  "(both >= 2), e.g. --corners 9,6",
+                                  args.corners));
+    spec.square_mm = args.spacing_mm;
+    return spec;
+  }
+  throw bad_input(fmt::format("--target '{}' is invalid: dots or chessboard", args.target));
+}
+
+// Point correspondences and image sizes, from the CSV or detected in target images.
+struct Inputs {
+  CorrespondenceTable table;
+  std::vector<calibration::ImageSize> sizes;
+  std::vector<std::string> camera_names;
+};
+
+// "--z-list -4.5,-3,..." in mm.
+std::vector<double> parse_z_list(const std::string& text) {
+  std::vector<double> z;
+  if (text.empty()) return z;
+  for (const std::string& item : split_list(text)) {
+    double value = 0;
+    const auto [ptr, ec] = std::from_chars(item.data(), item.data() + item.size(), value);
+    if (item.empty() || ec != std::errc() || ptr != item.data() + item.size() || !std::isfinite(value))
+      throw bad_input(fmt::format("--z-list '{}': '{}' is not a number of mm; give one plane z per set, e.g. "
+                                  "--z-list -4.5,-3,-1.5,0,1.5,3,4.5",
+                                  text, item));
+    z.push_back(value);
+  }
+  return z;
+}
+
+Inputs read_inputs(const CalibrateArgs& args) {
+  const int sources = !args.points.empty() + !args.images.empty() + !args.image_list.empty() + !args.session.empty();
+  if (sources != 1)
+    throw bad_input("give exactly one of --points CSV (correspondences made elsewhere), --images DIR, --image-list CSV "
+                    "or --session S.h5 (target images)");
+  if (!args.z_list.empty() && args.session.empty())
+    throw bad_input("--z-list gives the plane z of each set of a --session; it does not go with other sources");
+  Inputs in;
+  if (!args.points.empty()) {
+    in.table = read_correspondence_csv(args.points);
+    in.sizes = image_sizes(args, in.table.cameras.size());
+    for (std::size_t c = 0; c < in.table.cameras.size(); ++c) in.camera_names.push_back(fmt::format("camera {}", c));
+    return in;
+  }
+  if (!args.image_size.empty() || !args.camera_sizes.empty())
+    throw bad_input("--image-size and --camera-size go with --points only; with target images the size is the images'");
+  if (args.min_points_per_plane < 1)
+    throw bad_input(fmt::format("--min-points-per-plane {} is invalid: it must be >= 1", args.min_points_per_plane));
+  const calibration::TargetSpec spec = target_spec(args);
+  const TargetImageSet set = !args.session.empty()  ? read_session_targets(args.session, parse_z_list(args.z_list))
+                             : !args.images.empty() ? find_target_images(args.images)
+                                                    : read_image_list(args.image_list);
+  DetectedTargets detected = detect_targets(set, spec, args.min_points_per_plane);
+  for (const std::string& warning : detected.warnings) fmt::print(stderr, "warning: {}\n", warning);
+  if (args.target == "dots" && args.y_axis == "auto")
+    fmt::print(stderr, "world +y points {} the images (--y-axis auto: a right-handed x, y, z)\n", orient_y_axis(detected));
+  for (std::size_t c = 0; c < set.camera_names.size(); ++c)
+    fmt::print(stderr, "camera {} ({}): {} target points on {} images of {} x {} px\n", c, set.camera_names[c],
+               detected.table.cameras[c].size(),
+               std::count_if(set.images.begin(), set.images.end(), [&](const TargetImage& i) { return i.camera == static_cast<int>(c); }),
+               detected.image_sizes[c].width, detected.image_sizes[c].height);
+  if (!args.points_out.empty()) write_correspondence_csv(args.points_out, detected.table);
+  in.table = std::move(detected.table);
+  in.sizes = std::move(detected.image_sizes);
+  in.camera_names = set.camera_names;
+  return in;
 }
 
 void run(const CalibrateArgs& args) {
@@ -129,40 +232,61 @@ void run(const CalibrateArgs& args) {
                                 args.models));
   if (args.max_iterations < 1)
     throw bad_input(fmt::format("--max-iterations {} is invalid: it must be >= 1", args.max_iterations));
-  const CorrespondenceTable table = read_correspondence_csv(args.points);
-  const std::vector<calibration::ImageSize> sizes = image_sizes(args, table.cameras.size());
+  if (!args.points.empty() && !args.points_out.empty())
+    throw bad_input("--points-out writes the points detected in target images; it does not go with --points");
+  const Inputs in = read_inputs(args);
+
+  // With --stage-correction, every model is fitted to the corrected points (docs/calibration.md,
+  // "Traverse-error correction"); the last model of the list comes from the correction itself.
+  std::optional<calibration::TraverseCorrectionResult> traverse;
+  if (args.stage_correction) {
+    calibration::TraverseCorrectionOptions options;
+    options.final_model = models.back();
+    options.camera_names = in.camera_names;
+    options.fit.max_iterations = args.max_iterations;
+    traverse = calibration::correct_traverse(in.table.cameras, in.sizes, options);
+  }
 
   std::vector<ModelResult> results;
   std::vector<calibration::CameraCalibration> calibrations;
-  for (std::size_t i = 0; i < table.cameras.size(); ++i) {
+  for (std::size_t i = 0; i < in.table.cameras.size(); ++i) {
     calibration::FitOptions options;
     options.camera = fmt::format("camera {}", i);
     options.max_iterations = args.max_iterations;
+    const std::vector<calibration::PointCorrespondence>& points =
+        traverse ? traverse->corrected_points[i] : in.table.cameras[i];
     for (const std::string& model_name : models) {
       calibration::FitReport report;
-      // Errors (too few points, one plane, degenerate geometry, no convergence) propagate
-      // with the camera named; nothing is written unless every fit succeeds.
-      std::unique_ptr<calibration::CameraModel> model =
-          calibration::fit_camera_model(model_name, table.cameras[i], sizes[i], options, report);
-      results.push_back({static_cast<int>(i), report});
-      if (model_name == stored) calibrations.push_back({static_cast<int>(i), sizes[i], std::move(model), report});
+      std::unique_ptr<calibration::CameraModel> model;
+      if (traverse && model_name == models.back()) {
+        model = std::move(traverse->models[i]);
+        report = traverse->reports[i];
+      } else {
+        // Errors (too few points, one plane, degenerate geometry, no convergence) propagate
+        // with the camera named; nothing is written unless every fit succeeds.
+        model = calibration::fit_camera_model(model_name, points, in.sizes[i], options, report);
+      }
+      std::vector<PlaneResidual> planes = plane_residuals(*model, points);
+      // Corrected points sit at nominal z + offset; report the planes by their nominal z.
+      if (traverse && planes.size() == traverse->plane_z_mm.size())
+        for (std::size_t k = 0; k < planes.size(); ++k) planes[k].z_mm = traverse->plane_z_mm[k];
+      results.push_back({static_cast<int>(i), report, std::move(planes)});
+      if (model_name == stored) calibrations.push_back({static_cast<int>(i), in.sizes[i], std::move(model), report});
     }
   }
   calibration::save_calibration(args.out, calibrations);
 
+  std::optional<StageOffsets> offsets;
+  if (traverse)
+    offsets = StageOffsets{traverse->plane_z_mm, traverse->offsets_mm, traverse->per_camera_offsets_mm,
+                           in.camera_names, traverse->cycles, traverse->converged};
   if (args.json) {
-    nlohmann::json list = nlohmann::json::array();
-    for (const ModelResult& r : results)
-      list.push_back({{"camera", r.camera},
-                      {"model", r.report.model},
-                      {"points", r.report.points},
-                      {"planes", r.report.planes},
-                      {"forward_px", r.report.forward_mean_px},
-                      {"reverse_um", r.report.reverse_mean_um},
-                      {"converged", r.report.converged}});
-    fmt::print("{}\n", nlohmann::json{{"results", list}, {"stored", stored}, {"out", args.out}}.dump(2));
+    nlohmann::json j{{"results", report_json(results)}, {"stored", stored}, {"out", args.out}};
+    j["stage_correction"] = offsets ? stage_offsets_json(*offsets) : nlohmann::json(nullptr);
+    fmt::print("{}\n", j.dump(2));
   } else {
-    print_table(results, stored, args.out);
+    if (offsets) print_stage_offsets(*offsets);
+    print_report(results, stored, args.out);
   }
 }
 
@@ -170,9 +294,35 @@ void run(const CalibrateArgs& args) {
 
 void add_calibrate_command(CLI::App& root) {
   auto args = std::make_shared<CalibrateArgs>();
-  CLI::App* cmd = root.add_subcommand("calibrate", "Fit camera models to point correspondences and write a calibration file");
-  cmd->add_option("--points", args->points, "Point correspondences, CSV with the header camera,X,Y,Z,x,y (mm, px)")
-      ->required();
+  CLI::App* cmd = root.add_subcommand("calibrate", "Fit camera models to target images or point correspondences and write a calibration file");
+  cmd->add_option("--points", args->points, "Point correspondences made elsewhere, CSV with the header camera,X,Y,Z,x,y (mm, px)");
+  cmd->add_option("--images", args->images,
+                  "Target images: a folder with one sub-folder per camera (cam0, cam1, ...) of images named "
+                  "<z>mm*.tif, e.g. cam0/-3mm_cam0.tif");
+  cmd->add_option("--image-list", args->image_list, "Target images: a CSV with the header camera,z,file (z in mm)");
+  cmd->add_option("--session", args->session,
+                  "Target images: a session file, one set per plane, exposure A of each camera (e.g. from `tomorig "
+                  "simulate --case calib-thesis`); plane z from its truth or --z-list");
+  cmd->add_option("--z-list", args->z_list, "With --session: the plane z of each set, mm, comma-separated in set order");
+  cmd->add_flag("--stage-correction", args->stage_correction,
+                "Correct traverse errors of the target planes (thesis Sect. 6.3.3) before the final fits; prints the "
+                "per-plane offsets (needs >= 2 cameras and >= 2 planes)");
+  cmd->add_option("--target", args->target, "Target kind: dots (dot grid with origin marker) or chessboard")
+      ->capture_default_str();
+  cmd->add_option("--spacing", args->spacing_mm, "Dot spacing or chessboard square size, mm");
+  cmd->add_option("--dots", args->dots, "Dot polarity: white (on black) or black (on white)")->capture_default_str();
+  cmd->add_option("--y-axis", args->y_axis,
+                  "Image direction of world +y on a dot grid: down, up, or auto (whichever makes x, y, z right-handed, "
+                  "judged from the target's image growing or shrinking with z)")
+      ->capture_default_str();
+  cmd->add_option("--corners", args->corners, "Chessboard inner corners NX,NY");
+  cmd->add_option("--max-feature-px", args->max_feature_px,
+                  "Dot grid: dots and marker are smaller than this many pixels (0 = 1/8 of the image)")
+      ->capture_default_str();
+  cmd->add_option("--min-points-per-plane", args->min_points_per_plane,
+                  "Fewest target points an image must yield; fewer is an error naming camera and plane")
+      ->capture_default_str();
+  cmd->add_option("--points-out", args->points_out, "Also write the detected points as a correspondence CSV");
   cmd->add_option("--models", args->models,
                   "Models to fit, comma-separated: " + fmt::format("{}", fmt::join(calibration::camera_model_names(), ",")) +
                       "; each is fitted and reported, the last one is stored")

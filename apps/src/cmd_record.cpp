@@ -38,6 +38,7 @@ struct RecordOptions {
   std::optional<double> idle_timeout_s;
   bool overwrite = false;
   bool verbose = false;
+  double disk_reserve_mb = 64.0;
 };
 
 // How often receive() returns to the loop when nothing arrives: bounds how late an idle
@@ -91,6 +92,8 @@ void check_output(const RecordOptions& opt, const std::filesystem::path& out) {
 }
 
 void record(const RecordOptions& opt) {
+  if (!(opt.disk_reserve_mb >= 0.0))
+    throw bad_input(fmt::format("--disk-reserve-mb {:g} is invalid: it must be >= 0", opt.disk_reserve_mb));
   if (opt.sets && *opt.sets < 1) throw bad_input("--sets 0 is invalid: record at least one set (or omit --sets)");
   if (opt.idle_timeout_s && !(*opt.idle_timeout_s > 0.0))
     throw bad_input(fmt::format("--idle-timeout {:g} is invalid: it must be > 0 seconds", *opt.idle_timeout_s));
@@ -114,6 +117,7 @@ void record(const RecordOptions& opt) {
   writer_options.compression = *compression;
   writer_options.overwrite = opt.overwrite;
   writer_options.live = true;
+  writer_options.disk_reserve_bytes = static_cast<std::uint64_t>(opt.disk_reserve_mb * 1e6);
   std::unique_ptr<storage::SessionWriter> writer;
   std::vector<storage::SessionCamera> cameras;
 
@@ -168,6 +172,14 @@ void record(const RecordOptions& opt) {
     }
     try {
       writer->append(*set);
+    } catch (const storage::DiskFullError& e) {
+      // Nothing of this set was written: close the session cleanly with every set before it.
+      status.update(counts, receiver.stats(), /*final=*/true);
+      writer->finish();
+      fmt::print("recorded {} sets ({:.1f} MB of pixels) to {}\n", counts.written,
+                 static_cast<double>(counts.bytes_written) / 1e6, out.string());
+      throw runtime_error(fmt::format("recording stopped: {}; {} is complete with {} sets", e.what(), out.string(),
+                                      counts.written));
     } catch (const Error& e) {
       // The live writer keeps "<name>.partial" with every set written so far.
       status.update(counts, receiver.stats(), /*final=*/true);
@@ -211,6 +223,9 @@ void add_record_command(CLI::App& root) {
       ->capture_default_str();
   cmd->add_option("--idle-timeout", opt->idle_timeout_s, "Stop when no set arrived for this many seconds");
   cmd->add_flag("--overwrite", opt->overwrite, "Replace an existing output file");
+  cmd->add_option("--disk-reserve-mb", opt->disk_reserve_mb,
+                  "Stop recording cleanly when the disk would have less than this many MB free")
+      ->capture_default_str();
   cmd->add_flag("-v,--verbose", opt->verbose, "Print a line for every set written");
   cmd->callback([opt] { record(*opt); });
 }

@@ -11,9 +11,11 @@
 #include <fmt/core.h>
 
 #include "commands.h"
+#include "simulate_calib_target.h"
 #include "simulate_session.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
+#include "tomorig/simulators/calibration_target.h"
 #include "tomorig/simulators/cases.h"
 #include "tomorig/storage/session_file.h"
 
@@ -31,18 +33,39 @@ struct SimulateFlags {
   int bit_depth = 0;
   std::string compression = "none";
   bool overwrite = false;
+  bool reduced = false;
+  double distortion_px = sim::CalibTargetOptions{}.distortion_corner_px;
   // Which optional flags were given: only those override the rig config.
   CLI::Option* case_opt = nullptr;
   CLI::Option* ppp_opt = nullptr;
   CLI::Option* sets_opt = nullptr;
   CLI::Option* seed_opt = nullptr;
   CLI::Option* bit_depth_opt = nullptr;
+  CLI::Option* distortion_opt = nullptr;
 };
+
+// calib-thesis is a target case, not a particle case: it has its own renderer and writes one
+// set per traverse plane (simulate_calib_target.h). Noise is always on; --seed picks the stage
+// errors and the noise.
+void run_calib_thesis(const SimulateFlags& f, storage::Compression compression) {
+  if (f.ppp_opt->count() || f.sets_opt->count() || f.bit_depth_opt->count() || !f.config.empty())
+    throw bad_input("--case calib-thesis takes no --ppp, --sets, --bit-depth or --config: it renders one set per "
+                    "traverse plane of a chessboard target (16-bit)");
+  sim::CalibTargetOptions o;
+  o.reduced = f.reduced;
+  if (f.seed_opt->count()) o.seed = f.seed;
+  o.distortion_corner_px = f.distortion_px;
+  fmt::print("{}\n", write_calib_target_session(o, f.out, compression, f.overwrite));
+}
 
 void run_simulate(const SimulateFlags& f) {
   const auto compression = storage::parse_compression(f.compression);
   if (!compression)
     throw bad_input(fmt::format("--compression '{}' is unknown: use none or bitshuffle-lz4", f.compression));
+
+  if (f.case_opt->count() && f.case_name == "calib-thesis") return run_calib_thesis(f, *compression);
+  if (f.reduced || f.distortion_opt->count())
+    throw bad_input("--reduced and --distortion-px apply to --case calib-thesis only");
 
   config::RigConfig rig = f.config.empty() ? config::default_rig_config() : config::load_rig_config(f.config);
   if (!rig.simulation) rig.simulation.emplace();
@@ -107,7 +130,8 @@ void add_simulate_command(CLI::App& root) {
   auto flags = std::make_shared<SimulateFlags>();
   CLI::App* cmd = root.add_subcommand(
       "simulate", "Render a built-in synthetic case into a session file (HDF5) with its ground truth");
-  flags->case_opt = cmd->add_option("--case", flags->case_name, "simulation case: " + sim::case_names());
+  flags->case_opt =
+      cmd->add_option("--case", flags->case_name, "simulation case: " + sim::case_names() + ", calib-thesis");
   flags->ppp_opt = cmd->add_option("--ppp", flags->ppp, "particle images per pixel, in (0, 1]");
   flags->sets_opt = cmd->add_option("--sets", flags->sets, "number of double-frame sets to render");
   flags->seed_opt = cmd->add_option("--seed", flags->seed, "random seed (recorded in the truth)");
@@ -118,6 +142,9 @@ void add_simulate_command(CLI::App& root) {
   cmd->add_option("--compression", flags->compression, "frame compression: none or bitshuffle-lz4")
       ->capture_default_str();
   cmd->add_flag("--overwrite", flags->overwrite, "replace an existing output file");
+  cmd->add_flag("--reduced", flags->reduced, "calib-thesis: the reduced 640 x 540 variant (for tests)");
+  flags->distortion_opt = cmd->add_option("--distortion-px", flags->distortion_px,
+                                          "calib-thesis: radial lens distortion at the image corner, full-size px");
   cmd->callback([flags] { run_simulate(*flags); });
 }
 

@@ -14,10 +14,14 @@ void add_import_command(CLI::App& root);    // cmd_import.cpp
 void add_run_command(CLI::App& root);       // cmd_run.cpp: the main job on a rig config
 void add_replay_command(CLI::App& root);   // cmd_replay.cpp
 void add_record_command(CLI::App& root);   // cmd_record.cpp
+void add_acquire_command(CLI::App& root);  // cmd_acquire.cpp: the acquisition half of a split rig
 void add_trigger_command(CLI::App& root);   // cmd_trigger.cpp: trigger plan
 void add_reconstruct_command(CLI::App& root);  // cmd_reconstruct.cpp
 void add_calibrate_command(CLI::App& root);  // cmd_calibrate.cpp
 void add_preprocess_command(CLI::App& root);  // cmd_preprocess.cpp
+void add_selfcal_command(CLI::App& root);   // cmd_selfcal.cpp: volume self-calibration
+void add_process_command(CLI::App& root);  // cmd_process.cpp: the back-end pipeline
+void add_piv3d_command(CLI::App& root);    // cmd_piv3d.cpp: correlate two volumes
 void add_bench_command(CLI::App& root);     // cmd_bench.cpp: bench stream | record | recon
 
 }  // namespace tomorig::app

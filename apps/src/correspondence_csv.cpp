@@ -129,4 +129,14 @@ CorrespondenceTable read_correspondence_csv(const std::filesystem::path& path) {
   return table;
 }
 
+void write_correspondence_csv(const std::filesystem::path& path, const CorrespondenceTable& table) {
+  std::ofstream out(path);
+  if (!out) throw bad_input(fmt::format("cannot write the point file '{}'; check the folder exists and is writable", path.string()));
+  out << "camera,X,Y,Z,x,y\n";
+  for (std::size_t c = 0; c < table.cameras.size(); ++c)
+    for (const auto& p : table.cameras[c])
+      out << fmt::format("{},{},{},{},{},{}\n", c, p.world.x, p.world.y, p.world.z, p.pixel.x, p.pixel.y);
+  if (!out) throw bad_input(fmt::format("writing the point file '{}' failed", path.string()));
+}
+
 }  // namespace tomorig::app

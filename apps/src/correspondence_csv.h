@@ -25,4 +25,9 @@ struct CorrespondenceTable {
 // number, a negative camera index, or a camera index with no points below the highest one.
 CorrespondenceTable read_correspondence_csv(const std::filesystem::path& path);
 
+// Writes `table` in the same format (camera,X,Y,Z,x,y, numbers that read back exactly), e.g.
+// points detected by `tomorig calibrate --images` for use elsewhere. Throws bad_input naming
+// the file if it cannot be written.
+void write_correspondence_csv(const std::filesystem::path& path, const CorrespondenceTable& table);
+
 }  // namespace tomorig::app

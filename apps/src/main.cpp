@@ -21,13 +21,17 @@ int main(int argc, char** argv) {
   add_run_command(app);
   add_replay_command(app);
   add_record_command(app);
+  add_acquire_command(app);
   add_simulate_command(app);
   add_import_command(app);
   add_inspect_command(app);
   add_calibrate_command(app);
   add_reconstruct_command(app);
   add_preprocess_command(app);
+  add_selfcal_command(app);
   add_config_command(app);
+  add_process_command(app);
+  add_piv3d_command(app);
   add_bench_command(app);
   add_trigger_command(app);
 

@@ -6,7 +6,7 @@ namespace tomorig::sim {
 
 const std::vector<CaseDefinition>& cases() {
   // Built once, on first use; every case is a plain value after that.
-  static const std::vector<CaseDefinition> all{tpiv_thesis_case()};
+  static const std::vector<CaseDefinition> all{tpiv_thesis_case(), size_thesis_spray_case()};
   return all;
 }
 

@@ -83,14 +83,38 @@ Image SimulatedRig::render_signal(std::size_t camera, std::span<const Vec3d> par
 }
 
 SimulatedSet SimulatedRig::render_set(std::uint64_t set_index) const {
+  return render_set(set_index, options_.dt_ns);
+}
+
+SimulatedSet SimulatedRig::render_set(std::uint64_t set_index, std::int64_t dt_ns) const {
+  if (dt_ns < 0) throw bad_input(fmt::format("simulation: set {}: dt_ns = {} must be >= 0", set_index, dt_ns));
+  if (options_.dt_ns == 0 && dt_ns != 0)
+    throw bad_input(fmt::format("simulation: set {}: dt_ns = {} cannot be rendered: the flow's time base "
+                                "(options dt_ns) is 0",
+                                set_index, dt_ns));
   SimulatedSet out;
-  ParticlePair pair = straddle(particle_midpoints(set_index), *flow_);
+  const std::vector<Vec3d> midpoints = particle_midpoints(set_index);
+  ParticlePair pair;
+  if (dt_ns == options_.dt_ns) {
+    pair = straddle(midpoints, *flow_);
+  } else {
+    // A steady flow: the displacement grows linearly with the pulse separation. Central
+    // straddling keeps the mid-time positions; only the half-displacements scale.
+    const double half_scale = 0.5 * static_cast<double>(dt_ns) / static_cast<double>(options_.dt_ns);
+    pair.a.resize(midpoints.size());
+    pair.b.resize(midpoints.size());
+    for (std::size_t n = 0; n < midpoints.size(); ++n) {
+      const Vec3d half = flow_->displacement(midpoints[n]) * half_scale;
+      pair.a[n] = midpoints[n] - half;
+      pair.b[n] = midpoints[n] + half;
+    }
+  }
 
   FrameSet& frames = out.frames;
   frames.set_index = set_index;
   frames.trigger_index = set_index;
   frames.trigger_timestamp_ns = std::llround(static_cast<double>(set_index) * 1e9 / options_.rate_hz);
-  frames.dt_ns = options_.dt_ns;
+  frames.dt_ns = dt_ns;
   frames.cameras.resize(cameras_.size());
 
   // One job per (camera, exposure): 8 independent images for tpiv-thesis. Parallel over
@@ -119,7 +143,7 @@ SimulatedSet SimulatedRig::render_set(std::uint64_t set_index) const {
           derive_seed(options_.seed, {kNoiseStream, set_index, c, static_cast<std::uint64_t>(e)});
       Frame& frame = frames.cameras[c][e];
       frame.image = digitise(signal, sensor, noise_seed);
-      frame.timestamp_ns = frames.trigger_timestamp_ns + (e == Exposure::A ? 0 : options_.dt_ns);
+      frame.timestamp_ns = frames.trigger_timestamp_ns + (e == Exposure::A ? 0 : dt_ns);
     } catch (...) {
       errors[job] = std::current_exception();
     }

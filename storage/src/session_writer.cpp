@@ -1,5 +1,7 @@
 // SessionWriter: creates the layout of docs/file-formats.md in "<path>.partial", appends
 // sets, and renames the file to <path> on finish().
+#include <sys/statvfs.h>
+
 #include <array>
 #include <chrono>
 #include <optional>
@@ -82,6 +84,12 @@ struct SessionWriter::Impl {
   void store_truth(const SessionTruth& truth);
   void store_truth_set(std::uint64_t set_index, const TruthSet& truth);
   void flush_if_due();
+  // After a failed write (a full disk): shrinks /sets/trigger_index back to the sets of the
+  // last successful flush, best effort, so that a reader of the kept partial file never counts
+  // a set whose pixels may not have reached the disk. Never throws.
+  void roll_back_unflushed() noexcept;
+  // Throws DiskFullError if the collected set, the deferred truth and the reserve do not fit.
+  void require_disk_room() const;
   // Live recordings: reopens the closed file without SWMR, marks it complete and writes the
   // truth held back while recording.
   void complete_live_file();
@@ -321,6 +329,36 @@ void SessionWriter::Impl::write_collected(const FrameSet& set) {
   if (options.live) flush_if_due();
 }
 
+void SessionWriter::Impl::roll_back_unflushed() noexcept {
+  const std::uint64_t kept = options.live ? sets_at_last_flush : 0;
+  try {
+    trigger_index.grow_to(kept);  // the shortest dataset decides how many sets a reader sees
+    H5Fflush(file.get(), H5F_SCOPE_LOCAL);
+  } catch (...) {
+    // The file may be past saving; the reader's own checks are the last line of defence.
+  }
+  sets = kept;
+}
+
+void SessionWriter::Impl::require_disk_room() const {
+  std::uint64_t needed = options.disk_reserve_bytes;
+  for (const Frame* frame : frames_)
+    if (frame != nullptr) needed += frame->image.size_bytes();  // compressed data is never larger by much
+  for (const auto& [index, truth] : deferred_truth_sets)
+    needed += (truth.particles_a.size() + truth.particles_b.size()) * sizeof(Vec3d);
+  struct statvfs disk {};
+  const fs::path folder = partial.path().has_parent_path() ? partial.path().parent_path() : fs::path(".");
+  if (statvfs(folder.c_str(), &disk) != 0) return;  // cannot tell: HDF5 will report a real failure
+  const std::uint64_t available = static_cast<std::uint64_t>(disk.f_bavail) * disk.f_frsize;
+  if (available >= needed) return;
+  constexpr double MB = 1e6;
+  throw DiskFullError(fmt::format(
+      "the disk holding '{}' is full: {:.1f} MB free, but set {} needs {:.1f} MB including the reserve of {:.1f} MB "
+      "kept for closing the file; nothing of set {} was written, the {} sets before it are kept",
+      partial.path().string(), static_cast<double>(available) / MB, sets, static_cast<double>(needed) / MB,
+      static_cast<double>(options.disk_reserve_bytes) / MB, sets, sets));
+}
+
 void SessionWriter::Impl::flush_if_due() {
   const auto now = std::chrono::steady_clock::now();
   const bool by_count = options.flush.every_sets > 0 && sets - sets_at_last_flush >= options.flush.every_sets;
@@ -350,10 +388,13 @@ void SessionWriter::append(const FrameSet& set) {
   Impl& m = *impl_;
   m.require_open("append a set");
   m.collect(set);
+  if (m.options.disk_reserve_bytes > 0) m.require_disk_room();
+  const std::uint64_t index = m.sets;
   try {
     m.write_collected(set);
   } catch (const h5::Failure& failure) {
-    m.fail_write(fmt::format("writing set {} to", m.sets), failure);
+    m.roll_back_unflushed();
+    m.fail_write(fmt::format("writing set {} to", index), failure);
   }
 }
 

@@ -1,8 +1,8 @@
-// The real GenICam path: two Aravis GigE Vision fake cameras (GVA on 127.0.0.1, GVB on
-// 127.0.0.2) speaking GVCP/GVSP over loopback, software-triggered, with images injected
-// through the fake's fill-pattern callback. Each fake needs its own address; adding one
-// needs root, so the suite adds 127.0.0.2 itself, removes it afterwards, and is skipped
-// (with a message) when not run as root.
+// The real GenICam path: Aravis GigE Vision fake cameras (GVA on 127.0.0.1, GVB on 127.0.0.2,
+// GVC on 127.0.0.3, GVD on 127.0.0.4) speaking GVCP/GVSP over loopback, software-triggered,
+// with images injected through the fake's fill-pattern callback. Each fake needs its own
+// address; adding one needs root, so the suite adds 127.0.0.2-4 itself, removes them
+// afterwards, and is skipped (with a message) when not run as root.
 #include <arv.h>
 #include <gtest/gtest.h>
 #include <fcntl.h>
@@ -12,17 +12,27 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdlib>
+#include <functional>
 #include <iostream>
+#include <memory>
 #include <mutex>
+#include <string>
+#include <vector>
 
+#include "temp_dir.h"
 #include "tomorig/acquisition/aravis_camera.h"
 #include "tomorig/acquisition/frame_set_assembler.h"
 #include "tomorig/core/error.h"
+#include "tomorig/simulators/simulated_rig.h"
+#include "tomorig/storage/session_file.h"
 
 namespace tomorig::acquisition {
 namespace {
 
 constexpr int kWidth = 64, kHeight = 48;
+constexpr int kFakes = 4;
+const char* const kAddresses[kFakes] = {"127.0.0.1", "127.0.0.2", "127.0.0.3", "127.0.0.4"};
+const char* const kSerials[kFakes] = {"GVA", "GVB", "GVC", "GVD"};
 
 // The value of pixel (x, y) of the k-th frame a camera is filled with: deterministic, so the
 // test knows what was injected without keeping it, and different in every frame and camera.
@@ -37,6 +47,9 @@ std::uint16_t injected_pixel(std::uint32_t salt, std::uint64_t k, int x, int y) 
 
 struct FillState {
   std::uint32_t salt = 0;
+  // When set, the k-th frame is a copy of images[k] (e.g. simulator renderings) instead of
+  // the hash pattern.
+  const std::vector<Image>* images = nullptr;
   std::atomic<std::uint64_t> filled{0};
   std::mutex mutex;
   std::condition_variable filled_one;  // the fake consumed a trigger and made a frame
@@ -51,8 +64,12 @@ void fill_pattern(ArvBuffer* buffer, void* data, guint32, guint32, ArvPixelForma
   auto* pixels = static_cast<std::uint16_t*>(const_cast<void*>(arv_buffer_get_data(buffer, &size)));
   if (pixels == nullptr || format != ARV_PIXEL_FORMAT_MONO_16) return;
   const std::uint64_t k = state->filled.load();
+  const Image* image = state->images != nullptr && k < state->images->size() ? &(*state->images)[k] : nullptr;
   for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) pixels[y * w + x] = injected_pixel(state->salt, k, x, y);
+    for (int x = 0; x < w; ++x)
+      pixels[y * w + x] = image != nullptr && x < image->width() && y < image->height()
+                              ? image->at<std::uint16_t>(x, y)
+                              : injected_pixel(state->salt, k, x, y);
   std::lock_guard lock(state->mutex);
   state->filled = k + 1;
   state->filled_one.notify_all();
@@ -60,35 +77,122 @@ void fill_pattern(ArvBuffer* buffer, void* data, guint32, guint32, ArvPixelForma
 
 bool run(const std::string& command) { return std::system((command + " >/dev/null 2>&1").c_str()) == 0; }
 
+// Triggers `cams` one frame at a time for `sets` double-frame sets (two triggers per set) and
+// hands every set the assembler emits to `take`, in order. A camera's next trigger is sent only
+// once its fake has made the previous frame (`fills[c]`, its fill callback ran): the fake keeps
+// one pending software trigger, so a second one before it fired would be lost. Returns a
+// failure (with a message) if a frame never came.
+::testing::AssertionResult acquire_sets(std::vector<AravisCamera*> cams, std::vector<FillState*> fills,
+                                        std::uint64_t sets, const std::function<void(FrameSet&&)>& take) {
+  AssemblerOptions ao;
+  for (auto* cam : cams) ao.camera_ids.push_back(cam->id());
+  ao.timeout = std::chrono::seconds(30);  // real clock; every set here must complete
+  FrameSetAssembler assembler(ao);
+  std::mutex mutex;
+  std::condition_variable arrived;
+  std::vector<std::uint64_t> delivered(cams.size(), 0);
+  for (std::size_t c = 0; c < cams.size(); ++c)
+    cams[c]->start([&, c](CameraFrame&& f) {
+      assembler.add_frame(c, std::move(f));
+      std::lock_guard lock(mutex);
+      ++delivered[c];
+      arrived.notify_all();
+    });
+  auto stop_all = [&] {
+    for (auto* cam : cams) cam->stop();
+  };
+  auto failure = [&](const std::string& what) {
+    stop_all();
+    const StreamStatistics s = cams[0]->statistics();
+    return ::testing::AssertionFailure() << what << " (" << cams[0]->id() << ": completed " << s.completed
+                                         << ", failures " << s.failures << ", underruns " << s.underruns << ")";
+  };
+  const std::uint64_t frames = 2 * sets;
+  for (std::uint64_t frame = 0; frame < frames; ++frame) {
+    for (auto* cam : cams) cam->software_trigger();
+    for (FillState* fill : fills) {
+      std::unique_lock lock(fill->mutex);
+      if (!fill->filled_one.wait_for(lock, std::chrono::seconds(5), [&] { return fill->filled.load() > frame; }))
+        return failure("a fake did not take trigger " + std::to_string(frame));
+    }
+    while (auto set = assembler.try_pop()) take(std::move(*set));
+  }
+  {
+    std::unique_lock lock(mutex);
+    const bool all = arrived.wait_for(lock, std::chrono::seconds(10), [&] {
+      for (auto d : delivered)
+        if (d < frames) return false;
+      return true;
+    });
+    if (!all) {
+      lock.unlock();
+      return failure("not every frame arrived");
+    }
+  }
+  stop_all();
+  assembler.flush();
+  while (auto set = assembler.try_pop()) take(std::move(*set));
+  return ::testing::AssertionSuccess();
+}
+
+// Every pixel of every frame of `set` is the hash pattern of camera c (salt c + 1).
+void expect_injected_pattern(const FrameSet& set) {
+  for (std::uint32_t c = 0; c < set.cameras.size(); ++c)
+    for (Exposure e : {Exposure::A, Exposure::B}) {
+      const Image& image = set.cameras[c][e].image;
+      ASSERT_EQ(image.width(), kWidth);
+      ASSERT_EQ(image.height(), kHeight);
+      const std::uint64_t k = 2 * set.trigger_index + (e == Exposure::A ? 0 : 1);
+      int wrong = 0;
+      for (int y = 0; y < kHeight; ++y)
+        for (int x = 0; x < kWidth; ++x) wrong += image.at<std::uint16_t>(x, y) != injected_pixel(c + 1, k, x, y);
+      EXPECT_EQ(wrong, 0) << "set " << set.trigger_index << " camera " << c << " frame " << (e == Exposure::A ? 'A' : 'B');
+    }
+}
+
+void expect_lossless(const AravisCamera& cam, std::uint64_t frames) {
+  const auto s = cam.statistics();
+  EXPECT_EQ(s.delivered, frames) << cam.id();
+  EXPECT_EQ(s.completed, frames) << cam.id();
+  EXPECT_EQ(s.failures, 0u) << cam.id();
+  EXPECT_EQ(s.underruns, 0u) << cam.id();
+  EXPECT_EQ(s.missing_packets, 0u) << cam.id();
+  EXPECT_EQ(s.frame_id_gaps, 0u) << cam.id();
+}
+
 class GigEFakeCameras : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     if (geteuid() != 0) return;
     // ctest may run these tests in parallel processes: they would fight over the GVCP port
-    // and one could remove the address another still uses. A lock file serialises them
+    // and one could remove an address another still uses. A lock file serialises them
     // (released when the process exits).
     lock_fd_ = ::open("/tmp/tomorig-gige-fake-test.lock", O_CREAT | O_RDWR, 0644);
     if (lock_fd_ >= 0) ::flock(lock_fd_, LOCK_EX);
     // Leave an address someone else configured alone; remove only what this suite added.
-    added_address_ = !run("ip -4 addr show dev lo | grep -q 'inet 127.0.0.2/'") && run("ip addr add 127.0.0.2/8 dev lo");
+    for (int c = 1; c < kFakes; ++c) {
+      const std::string address = kAddresses[c];
+      added_address_[c] = !run("ip -4 addr show dev lo | grep -q 'inet " + address + "/'") &&
+                          run("ip addr add " + address + "/8 dev lo");
+    }
   }
   static void TearDownTestSuite() {
-    if (added_address_) run("ip addr del 127.0.0.2/8 dev lo");
-    added_address_ = false;
+    for (int c = 1; c < kFakes; ++c) {
+      if (added_address_[c]) run(std::string("ip addr del ") + kAddresses[c] + "/8 dev lo");
+      added_address_[c] = false;
+    }
     if (lock_fd_ >= 0) ::close(lock_fd_);  // releases the lock
     lock_fd_ = -1;
   }
 
   void SetUp() override {
-    if (geteuid() != 0) GTEST_SKIP() << "needs root to add the loopback address 127.0.0.2 for the second GigE fake camera";
-    states_[0].salt = 1;
-    states_[1].salt = 2;
-    const char* addresses[2] = {"127.0.0.1", "127.0.0.2"};
-    const char* serials[2] = {"GVA", "GVB"};
-    for (int c = 0; c < 2; ++c) {
-      fakes_[c] = arv_gv_fake_camera_new(addresses[c], serials[c]);
+    if (geteuid() != 0)
+      GTEST_SKIP() << "needs root to add the loopback addresses 127.0.0.2-4 for the second to fourth GigE fake cameras";
+    for (int c = 0; c < kFakes; ++c) {
+      states_[c].salt = static_cast<std::uint32_t>(c + 1);
+      fakes_[c] = arv_gv_fake_camera_new(kAddresses[c], kSerials[c]);
       ASSERT_TRUE(fakes_[c] != nullptr && arv_gv_fake_camera_is_running(fakes_[c]))
-          << "GigE fake " << serials[c] << " could not listen on " << addresses[c];
+          << "GigE fake " << kSerials[c] << " could not listen on " << kAddresses[c];
       ArvFakeCamera* fake = arv_gv_fake_camera_get_fake_camera(fakes_[c]);
       arv_fake_camera_set_fill_pattern(fake, fill_pattern, &states_[c]);
       // The fake honours a software trigger only at this rate (25 Hz by default).
@@ -119,78 +223,98 @@ class GigEFakeCameras : public ::testing::Test {
     return o;
   }
 
-  inline static bool added_address_ = false;
+  inline static bool added_address_[kFakes] = {};
   inline static int lock_fd_ = -1;
-  ArvGvFakeCamera* fakes_[2] = {nullptr, nullptr};
-  FillState states_[2];
+  ArvGvFakeCamera* fakes_[kFakes] = {};
+  FillState states_[kFakes];
 };
 
 TEST_F(GigEFakeCameras, DoubleFrameSetsArriveCompleteAndBitIdenticalToWhatWasInjected) {
   constexpr std::uint64_t kSets = 75;  // 150 frames per camera, across the fake's 16-bit id wrap
   AravisCamera cams[2] = {AravisCamera("camA", software_triggered()), AravisCamera("camB", software_triggered())};
-  cams[0].configure(gige_config("camA", "127.0.0.1"));
-  cams[1].configure(gige_config("camB", "127.0.0.2"));
+  cams[0].configure(gige_config("camA", kAddresses[0]));
+  cams[1].configure(gige_config("camB", kAddresses[1]));
   EXPECT_EQ(cams[0].triggers_per_set(), 2);
 
-  AssemblerOptions ao;
-  ao.camera_ids = {"camA", "camB"};
-  ao.timeout = std::chrono::seconds(30);  // real clock; every set here must complete
-  FrameSetAssembler assembler(ao);
-  std::mutex mutex;
-  std::condition_variable arrived;
-  std::uint64_t delivered[2] = {0, 0};
-  for (std::size_t c = 0; c < 2; ++c)
-    cams[c].start([&, c](CameraFrame&& f) {
-      assembler.add_frame(c, std::move(f));
-      std::lock_guard lock(mutex);
-      ++delivered[c];
-      arrived.notify_all();
-    });
-
   std::uint64_t checked = 0;
-  for (std::uint64_t frame = 0; frame < 2 * kSets; ++frame) {
-    for (auto& cam : cams) cam.software_trigger();
-    {
-      // Wait for this trigger's frame from both cameras before the next trigger: the fake
-      // keeps one pending software trigger, a second one before it fired would be lost.
-      std::unique_lock lock(mutex);
-      ASSERT_TRUE(arrived.wait_for(lock, std::chrono::seconds(5),
-                                   [&] { return delivered[0] > frame && delivered[1] > frame; }))
-          << "frame " << frame << " did not arrive (delivered " << delivered[0] << ", " << delivered[1]
-          << "; camA completed " << cams[0].statistics().completed << ", failures " << cams[0].statistics().failures
-          << ", underruns " << cams[0].statistics().underruns << ")";
-    }
-    while (auto set = assembler.try_pop()) {
-      ASSERT_EQ(set->trigger_index, checked);
-      ASSERT_TRUE(set->complete()) << "set " << checked;
-      for (std::uint32_t c = 0; c < 2; ++c)
-        for (Exposure e : {Exposure::A, Exposure::B}) {
-          const Image& image = set->cameras[c][e].image;
-          ASSERT_EQ(image.width(), kWidth);
-          ASSERT_EQ(image.height(), kHeight);
-          const std::uint64_t k = 2 * checked + (e == Exposure::A ? 0 : 1);
-          int wrong = 0;
-          for (int y = 0; y < kHeight; ++y)
-            for (int x = 0; x < kWidth; ++x) wrong += image.at<std::uint16_t>(x, y) != injected_pixel(c + 1, k, x, y);
-          EXPECT_EQ(wrong, 0) << "set " << checked << " camera " << c << " frame " << (e == Exposure::A ? 'A' : 'B');
-        }
-      ++checked;
-    }
-  }
-  for (auto& cam : cams) cam.stop();
+  ASSERT_TRUE(acquire_sets({&cams[0], &cams[1]}, {&states_[0], &states_[1]}, kSets, [&](FrameSet&& set) {
+    ASSERT_EQ(set.trigger_index, checked);
+    ASSERT_TRUE(set.complete()) << "set " << checked;
+    expect_injected_pattern(set);
+    ++checked;
+  }));
   EXPECT_EQ(checked, kSets);
-  for (auto& cam : cams) {
-    const auto s = cam.statistics();
-    EXPECT_EQ(s.delivered, 2 * kSets) << cam.id();
-    EXPECT_EQ(s.completed, 2 * kSets) << cam.id();
-    EXPECT_EQ(s.failures, 0u) << cam.id();
-    EXPECT_EQ(s.underruns, 0u) << cam.id();
-    EXPECT_EQ(s.missing_packets, 0u) << cam.id();
-    EXPECT_EQ(s.frame_id_gaps, 0u) << cam.id();
+  for (auto& cam : cams) expect_lossless(cam, 2 * kSets);
+}
+
+// The acceptance test of the real GenICam path: four GigE Vision fakes with distinct serials,
+// fed simulator images, software-triggered; 200 double-frame sets are recorded into a live
+// session file with zero loss, and the recorded pixels are bit-identical to what was injected.
+TEST_F(GigEFakeCameras, FourCamerasRecord200DoubleFrameSetsLosslesslyAndBitIdentical) {
+  constexpr std::uint64_t kSets = 200;
+  // What each camera is fed: the simulator's frames A and B of sets 0..199, one view each.
+  sim::SimulationOptions sim_options;
+  sim_options.ppp = 0.05;
+  sim_options.seed = 5;
+  sim_options.threads = 1;
+  for (int c = 0; c < kFakes; ++c) {
+    sim::SimulatedCameraSpec spec;
+    spec.id = std::string("cam") + kSerials[c];
+    spec.yaw_deg = -30.0 + 20.0 * c;
+    spec.width = kWidth;
+    spec.height = kHeight;
+    sim_options.cameras.push_back(spec);
   }
-  const auto a = assembler.statistics();
-  EXPECT_EQ(a.sets_complete, kSets);
-  for (const auto& c : a.cameras) EXPECT_EQ(c.frames_missing + c.frames_late + c.frames_duplicate, 0u) << c.camera_id;
+  const sim::SimulatedRig simulator(sim_options);
+  std::vector<std::vector<Image>> injected(kFakes);
+  for (std::uint64_t k = 0; k < kSets; ++k) {
+    sim::SimulatedSet set = simulator.render_set(k);
+    for (int c = 0; c < kFakes; ++c) {
+      injected[c].push_back(std::move(set.frames.cameras[c].a.image));
+      injected[c].push_back(std::move(set.frames.cameras[c].b.image));
+    }
+  }
+  for (int c = 0; c < kFakes; ++c) states_[c].images = &injected[c];
+
+  std::vector<std::unique_ptr<AravisCamera>> cams;
+  std::vector<AravisCamera*> views;
+  storage::SessionInfo info;
+  for (int c = 0; c < kFakes; ++c) {
+    const std::string id = sim_options.cameras[c].id;
+    cams.push_back(std::make_unique<AravisCamera>(id, software_triggered()));
+    cams.back()->configure(gige_config(id, kAddresses[c]));
+    views.push_back(cams.back().get());
+    info.cameras.push_back({id, kWidth, kHeight, PixelFormat::Mono16, 7.4});
+  }
+  tomorig::testing::TempDir dir;
+  const auto path = dir / "gige.h5";
+  storage::SessionWriterOptions writer_options;
+  writer_options.live = true;
+  storage::SessionWriter writer(path, info, writer_options);
+  std::uint64_t recorded = 0;
+  ASSERT_TRUE(acquire_sets(views, {&states_[0], &states_[1], &states_[2], &states_[3]}, kSets, [&](FrameSet&& set) {
+    ASSERT_EQ(set.trigger_index, recorded);
+    ASSERT_TRUE(set.complete()) << "set " << recorded;
+    writer.append(set);
+    ++recorded;
+  }));
+  writer.finish();
+  ASSERT_EQ(recorded, kSets);
+  for (const auto& cam : cams) expect_lossless(*cam, 2 * kSets);
+
+  const storage::SessionReader session(path);
+  ASSERT_EQ(session.set_count(), kSets);
+  EXPECT_EQ(session.missing_frames(), 0);
+  EXPECT_TRUE(session.recording_complete());
+  for (std::uint64_t k = 0; k < kSets; ++k) {
+    const FrameSet set = session.read_set(k);
+    ASSERT_EQ(set.cameras.size(), static_cast<std::size_t>(kFakes));
+    for (int c = 0; c < kFakes; ++c) {
+      ASSERT_EQ(set.cameras[c].camera_id, sim_options.cameras[c].id);
+      EXPECT_TRUE(set.cameras[c].a.image.same_pixels(injected[c][2 * k])) << "set " << k << " camera " << c << " A";
+      EXPECT_TRUE(set.cameras[c].b.image.same_pixels(injected[c][2 * k + 1])) << "set " << k << " camera " << c << " B";
+    }
+  }
 }
 
 TEST_F(GigEFakeCameras, UnsupportedPixelFormatAndAbsentCameraAreNamed) {
@@ -206,7 +330,7 @@ TEST_F(GigEFakeCameras, UnsupportedPixelFormatAndAbsentCameraAreNamed) {
     EXPECT_NE(std::string(e.what()).find("camA"), std::string::npos) << e.what();
   }
   AravisCamera absent("camZ", software_triggered());
-  cfg = gige_config("camZ", "127.0.0.1");
+  cfg = gige_config("camZ", kAddresses[0]);
   cfg.device_id = "Aravis-Fake-GVZ";
   try {
     absent.configure(cfg);

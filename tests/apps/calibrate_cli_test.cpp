@@ -178,6 +178,7 @@ TEST_F(CalibrateCli, AFitThatDoesNotConvergeIsARuntimeFailureNamingTheCamera) {
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find("camera 0"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("did not converge"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--max-iterations"), std::string::npos) << r.err;  // the flag the user can change
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 

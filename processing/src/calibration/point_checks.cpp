@@ -133,8 +133,8 @@ void check_fit(const LmResult& lm, int parameters, const std::string& model, con
                                 options.camera, model, parameters, what, lm.conditioning));
   if (!lm.converged && options.require_convergence)
     throw runtime_error(fmt::format("{}: the {} fit of the {} did not converge in {} iterations (sum of squared "
-                                    "residuals {:.3g}, normalised units); check the correspondences for outliers, or raise "
-                                    "max_iterations",
+                                    "residuals {:.3g}, normalised units); check the correspondences for outliers, or allow more "
+                                    "iterations (--max-iterations on the command line, FitOptions::max_iterations in code)",
                                     options.camera, model, what, lm.iterations, lm.cost));
 }
 

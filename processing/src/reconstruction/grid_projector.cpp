@@ -151,4 +151,50 @@ void GridProjector::row(std::size_t c, int j, int k, float* u, float* v) const {
   }
 }
 
+void GridProjector::row_at(std::size_t c, int j, int k, const int* voxels, int count, float* u, float* v) const {
+  const Lattice& l = cams_[c];
+  if (l.step == 1) {
+    for (int n = 0; n < count; ++n) {
+      const int i = voxels[n];
+      const Vec2d p = project_or_nowhere(*l.model, grid_.centre_of(i, j, k));
+      u[i] = static_cast<float>(p.x);
+      v[i] = static_cast<float>(p.y);
+    }
+    return;
+  }
+  if (count == 0) return;
+  const int s = l.step;
+  const int cb = std::min(j / s, l.nodes_y - 2), cc = std::min(k / s, l.nodes_z - 2);
+  const float fb = static_cast<float>(j - cb * s) / s, fc = static_cast<float>(k - cc * s) / s;
+  const float w00 = (1 - fb) * (1 - fc), w10 = fb * (1 - fc), w01 = (1 - fb) * fc, w11 = fb * fc;
+  const std::size_t plane = static_cast<std::size_t>(l.nodes_x) * l.nodes_y;
+  const std::size_t r00 = static_cast<std::size_t>(l.nodes_x) * cb + plane * cc;
+  const std::size_t r10 = r00 + l.nodes_x, r01 = r00 + plane, r11 = r00 + plane + l.nodes_x;
+  // The row's lattice nodes (a few dozen), then each listed voxel from its segment, with the
+  // same arithmetic as row().
+  constexpr int kMaxNodes = 256;
+  float nu[kMaxNodes], nv[kMaxNodes];
+  if (l.nodes_x > kMaxNodes) {
+    std::vector<float> fu(static_cast<std::size_t>(grid_.nx)), fv(static_cast<std::size_t>(grid_.nx));
+    row(c, j, k, fu.data(), fv.data());
+    for (int n = 0; n < count; ++n) {
+      u[voxels[n]] = fu[static_cast<std::size_t>(voxels[n])];
+      v[voxels[n]] = fv[static_cast<std::size_t>(voxels[n])];
+    }
+    return;
+  }
+  for (int a = 0; a < l.nodes_x; ++a) {
+    nu[a] = w00 * l.u[r00 + a] + w10 * l.u[r10 + a] + w01 * l.u[r01 + a] + w11 * l.u[r11 + a];
+    nv[a] = w00 * l.v[r00 + a] + w10 * l.v[r10 + a] + w01 * l.v[r01 + a] + w11 * l.v[r11 + a];
+  }
+  for (int n = 0; n < count; ++n) {
+    const int i = voxels[n];
+    const int a = std::min(i / s, l.nodes_x - 2);
+    const int i0 = a * s;
+    const float du = (nu[a + 1] - nu[a]) / s, dv = (nv[a + 1] - nv[a]) / s;
+    u[i] = nu[a] + du * (i - i0);
+    v[i] = nv[a] + dv * (i - i0);
+  }
+}
+
 }  // namespace tomorig::recon::detail

@@ -22,6 +22,10 @@ class GridProjector {
   // Pixel positions (u, v) in camera c of voxels (0 .. nx-1, j, k).
   void row(std::size_t c, int j, int k, float* u, float* v) const;
 
+  // Pixel positions in camera c of the listed voxels (i = voxels[0 .. count-1], row j, slice
+  // k), written to u[i], v[i]: what row() gives there, without filling the whole row.
+  void row_at(std::size_t c, int j, int k, const int* voxels, int count, float* u, float* v) const;
+
   // Lattice step used for camera c; 1 means exact projection of every voxel.
   int step(std::size_t c) const { return cams_[c].step; }
   // Largest interpolation error found at the cell centres, pixels (0 for exact projection).

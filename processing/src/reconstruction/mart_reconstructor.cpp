@@ -32,7 +32,7 @@ RayTable rays_of(const SparseSystem& system, std::size_t c) {
       for (int b = 0; b < p; ++b)
         for (int a = 0; a < p; ++a) {
           const std::int32_t pixel = patch.offset + b * stride + a;
-          if (system.inside(c, pixel)) visit(n, pixel, patch.wu[a] * patch.wv[b]);
+          if (system.inside(c, pixel)) visit(n, pixel, patch.weight(a, b));
         }
     }
   };

@@ -38,11 +38,33 @@ struct SampledImage {
     nonzero_fraction = static_cast<double>(nonzero) / (static_cast<double>(width) * height);
   }
 
-  // Bilinear interpolation at (u, v); 0 outside the image span.
-  float sample(float u, float v) const {
-    if (!(u >= -0.5f && u <= width - 0.5f && v >= -0.5f && v <= height - 0.5f)) return 0.0f;
-    // u, v >= -0.5 here, so truncating u + 1 floors it, without a libm call (baseline x86-64
-    // has no SSE4.1 round instruction, and std::floor is a function call there).
+  // reach[y * stride + x] != 0 iff one of the four pixels a bilinear sample with
+  // x = floor(u + 1), y = floor(v + 1) reads is non-empty: one byte decides most voxels.
+  std::vector<std::uint8_t> reach;
+  double reach_fraction = 0.0;
+
+  void build_reach() {
+    reach.assign(pixels.size(), 0);
+    std::size_t count = 0;
+    for (int y = 0; y <= height; ++y)
+      for (int x = 0; x <= width; ++x) {
+        const float* p = pixels.data() + static_cast<std::size_t>(y) * stride + x;
+        const bool any = p[0] > 0 || p[1] > 0 || p[stride] > 0 || p[stride + 1] > 0;
+        reach[static_cast<std::size_t>(y) * stride + x] = any;
+        count += any;
+      }
+    reach_fraction = static_cast<double>(count) / (static_cast<double>(width + 1) * (height + 1));
+  }
+
+  // Whether (u, v) lies inside the image span and next to a non-empty pixel.
+  bool reaches(float u, float v) const {
+    const bool in = u >= -0.5f && u <= width - 0.5f && v >= -0.5f && v <= height - 0.5f;
+    const int x = in ? static_cast<int>(u + 1.0f) : 0, y = in ? static_cast<int>(v + 1.0f) : 0;
+    return in && reach[static_cast<std::size_t>(y) * stride + x] != 0;
+  }
+
+  // Bilinear interpolation at (u, v) known to be inside the image span.
+  float sample_inside(float u, float v) const {
     const int x = static_cast<int>(u + 1.0f), y = static_cast<int>(v + 1.0f);
     const float ax = u + 1.0f - static_cast<float>(x), ay = v + 1.0f - static_cast<float>(y);
     const float* p = pixels.data() + static_cast<std::size_t>(y) * stride + x;
@@ -64,12 +86,15 @@ ActiveSet run_mlos(const PreparedInput& in, const GridProjector& projector, cons
   const VoxelGrid& g = in.grid;
   const std::size_t cams = in.camera_count();
   std::vector<SampledImage> images;
-  for (const CameraImage& image : in.images) images.emplace_back(image, settings.threshold);
+  for (const CameraImage& image : in.images) {
+    images.emplace_back(image, settings.threshold);
+    images.back().build_reach();
+  }
   // The most selective camera first: most voxels then stop after one lookup.
   std::vector<std::size_t> order(cams);
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return images[a].nonzero_fraction < images[b].nonzero_fraction;
+    return images[a].reach_fraction < images[b].reach_fraction;
   });
 
   const double limit_mb = settings.memory_limit_mb > 0 ? settings.memory_limit_mb : usable_memory_mb();
@@ -95,32 +120,45 @@ ActiveSet run_mlos(const PreparedInput& in, const GridProjector& projector, cons
         out.v.resize(cams);
       }
       for (int j = 0; j < g.ny; ++j) {
+        // First camera: the whole row's positions (a linear fill), one byte of the reach mask
+        // per voxel, and the bilinear sample only where it can be non-zero. Later cameras:
+        // positions and samples of the surviving voxels only.
         int count = 0;
-        for (std::size_t o = 0; o < cams; ++o) {
-          const std::size_t c = order[o];
+        {
+          const std::size_t c = order[0];
           float* uc = u.data() + c * g.nx;
           float* vc = v.data() + c * g.nx;
           projector.row(c, j, k, uc, vc);
           const SampledImage& image = images[c];
-          if (o == 0) {
-            for (int i = 0; i < g.nx; ++i) {
-              const float s = image.sample(uc[i], vc[i]);
-              product[i] = s;
-              alive[count] = i;
-              count += s > 0.0f;
-            }
-          } else {
-            int kept = 0;
-            for (int n = 0; n < count; ++n) {
-              const int i = alive[n];
-              const float s = image.sample(uc[i], vc[i]);
-              product[i] *= s;
-              alive[kept] = i;
-              kept += s > 0.0f;
-            }
-            count = kept;
+          for (int i = 0; i < g.nx; ++i) {
+            alive[count] = i;
+            count += image.reaches(uc[i], vc[i]);
           }
-          if (count == 0) break;
+          int kept = 0;
+          for (int n = 0; n < count; ++n) {
+            const int i = alive[n];
+            const float s = image.sample_inside(uc[i], vc[i]);
+            product[i] = s;
+            alive[kept] = i;
+            kept += s > 0.0f;
+          }
+          count = kept;
+        }
+        for (std::size_t o = 1; o < cams && count > 0; ++o) {
+          const std::size_t c = order[o];
+          float* uc = u.data() + c * g.nx;
+          float* vc = v.data() + c * g.nx;
+          projector.row_at(c, j, k, alive.data(), count, uc, vc);
+          const SampledImage& image = images[c];
+          int kept = 0;
+          for (int n = 0; n < count; ++n) {
+            const int i = alive[n];
+            const float s = image.reaches(uc[i], vc[i]) ? image.sample_inside(uc[i], vc[i]) : 0.0f;
+            product[i] *= s;
+            alive[kept] = i;
+            kept += s > 0.0f;
+          }
+          count = kept;
         }
         for (int n = 0; n < count; ++n) {
           const int i = alive[n];
@@ -144,27 +182,29 @@ ActiveSet run_mlos(const PreparedInput& in, const GridProjector& projector, cons
     throw bad_input(fmt::format("reconstruction: {} needs more than the {:.0f} MB available", what, limit_mb));
   }
 
+  // Slices concatenated in z order; each slice copies into its own range, in parallel.
   ActiveSet set;
-  const std::size_t total = active.load();
-  set.index.reserve(total);
-  set.value.reserve(total);
+  std::vector<std::size_t> first(slices.size() + 1, 0);
+  for (std::size_t k = 0; k < slices.size(); ++k) first[k + 1] = first[k] + slices[k].index.size();
+  const std::size_t total = first.back();
+  set.index.resize(total);
+  set.value.resize(total);
   if (settings.keep_positions) {
-    set.u.assign(cams, {});
-    set.v.assign(cams, {});
-    for (std::size_t c = 0; c < cams; ++c) {
-      set.u[c].reserve(total);
-      set.v[c].reserve(total);
-    }
+    set.u.assign(cams, std::vector<float>(total));
+    set.v.assign(cams, std::vector<float>(total));
   }
-  for (SliceResult& s : slices) {
-    set.index.insert(set.index.end(), s.index.begin(), s.index.end());
-    set.value.insert(set.value.end(), s.value.begin(), s.value.end());
+#pragma omp parallel for num_threads(in.threads) schedule(dynamic, 4)
+  for (int k = 0; k < g.nz; ++k) {
+    SliceResult& s = slices[static_cast<std::size_t>(k)];
+    const std::size_t at = first[static_cast<std::size_t>(k)];
+    std::copy(s.index.begin(), s.index.end(), set.index.begin() + at);
+    std::copy(s.value.begin(), s.value.end(), set.value.begin() + at);
     if (settings.keep_positions)
       for (std::size_t c = 0; c < cams; ++c) {
-        set.u[c].insert(set.u[c].end(), s.u[c].begin(), s.u[c].end());
-        set.v[c].insert(set.v[c].end(), s.v[c].begin(), s.v[c].end());
+        std::copy(s.u[c].begin(), s.u[c].end(), set.u[c].begin() + at);
+        std::copy(s.v[c].begin(), s.v[c].end(), set.v[c].begin() + at);
       }
-    s = {};  // release as we go: the peak is one copy plus one slice
+    s = {};
   }
   return set;
 }

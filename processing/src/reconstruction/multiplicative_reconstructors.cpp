@@ -6,18 +6,38 @@
 //   SMART: project every camera from the same intensities, then update once by the weighted
 //          geometric mean over all cameras, prod_m prod_i R_i^(mu w_ij / M) (Eq. 3.5, with
 //          1/N_i taken as 1/M: each camera's weights sum to ~1).
-// So their times per iteration compare the algorithms, not the care taken over each.
+// Both prune the same way (options.prune_fraction), so their times per iteration compare the
+// algorithms, not the care taken over each.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
 #include "algorithms.h"
+#include "fast_math.h"
 #include "sparse_system.h"
+#include "stage_timer.h"
 #include "support.h"
 
 namespace tomorig::recon::detail {
 namespace {
 
 enum class Schedule { by_camera, simultaneous };
+
+// Sets voxels below `fraction` of the largest intensity to 0; returns how many are > 0.
+std::size_t zero_faint(std::vector<float>& e, double fraction, int threads) {
+  const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(e.size());
+  float largest = 0.0f;
+#pragma omp parallel for num_threads(threads) schedule(static) reduction(max : largest)
+  for (std::ptrdiff_t n = 0; n < count; ++n) largest = std::max(largest, e[n]);
+  const float cut = static_cast<float>(fraction) * largest;
+  std::size_t live = 0;
+#pragma omp parallel for num_threads(threads) schedule(static) reduction(+ : live)
+  for (std::ptrdiff_t n = 0; n < count; ++n) {
+    if (e[n] < cut) e[n] = 0.0f;
+    live += e[n] > 0.0f;
+  }
+  return live;
+}
 
 class MultiplicativeReconstructor final : public Reconstructor {
  public:
@@ -27,6 +47,7 @@ class MultiplicativeReconstructor final : public Reconstructor {
 
   SparseVolume reconstruct(const ReconstructionInput& input, ReconstructionReport& report) override {
     const auto start = std::chrono::steady_clock::now();
+    StageTimer timer(schedule_ == Schedule::by_camera ? "fmart" : "smart");
     report = {};
     report.algorithm = name();
     SupportNeeds needs;
@@ -38,16 +59,36 @@ class MultiplicativeReconstructor final : public Reconstructor {
     SparseSystem system(s.in, s.set, s.patch, options_.lut_steps);
     s.set.u.clear();  // the system holds the patches now
     s.set.v.clear();
+    s.set.u.shrink_to_fit();
+    s.set.v.shrink_to_fit();
+    std::vector<std::uint32_t> index = std::move(s.set.index);
     std::vector<float> e = std::move(s.set.value);
     if (!options_.mlos_initial_intensity) std::fill(e.begin(), e.end(), 1.0f);
     std::vector<float> acc(schedule_ == Schedule::simultaneous ? e.size() : 0);
-    report.setup_seconds = seconds_since(start);
+    timer.mark("sparse system");
+
+    double observer_time = 0.0;
+    auto elapsed = [&] { return seconds_since(start) - observer_time; };
+    auto notify = [&](int iteration, const IterationStats* stats) {
+      if (!observer_) return;
+      const auto t0 = std::chrono::steady_clock::now();
+      IterationView view;
+      view.iteration = iteration;
+      view.stats = stats;
+      view.elapsed_seconds = elapsed();
+      view.volume = [&] { return to_volume(s.in.grid, index, e); };
+      observer_(view);
+      observer_time += seconds_since(t0);
+    };
+    report.setup_seconds = elapsed();
+    notify(0, nullptr);
 
     const float mu = static_cast<float>(options_.relaxation);
     const std::size_t cams = system.cameras();
-    const double updates = std::max<double>(1.0, static_cast<double>(e.size()) * (schedule_ == Schedule::by_camera ? cams : 1));
     for (int it = 1; it <= options_.max_iterations; ++it) {
       const auto t0 = std::chrono::steady_clock::now();
+      const double updates =
+          std::max<double>(1.0, static_cast<double>(e.size()) * (schedule_ == Schedule::by_camera ? cams : 1));
       double diff = 0, measured = 0, update_sum = 0;
       if (schedule_ == Schedule::by_camera) {
         for (std::size_t c = 0; c < cams; ++c) {
@@ -69,21 +110,50 @@ class MultiplicativeReconstructor final : public Reconstructor {
 #pragma omp parallel for num_threads(threads) schedule(static) reduction(+ : update_sum)
         for (std::ptrdiff_t n = 0; n < count; ++n) {
           if (e[n] == 0.0f) continue;
-          const float factor = std::exp(scale * acc[n]);
+          const float factor = fast_exp(scale * acc[n]);
           e[n] *= factor;
           update_sum += std::fabs(1.0f - factor);
         }
       }
-      if (record_iteration(report, it, measured > 0 ? diff / measured : 0.0, update_sum / updates, seconds_since(t0),
-                           options_.stop_mean_update))
-        break;
+      if (options_.prune_fraction > 0) prune(system, index, e, acc, threads);
+      const bool stop = record_iteration(report, it, measured > 0 ? diff / measured : 0.0, update_sum / updates,
+                                         seconds_since(t0), options_.stop_mean_update);
+      report.history.back().elapsed_seconds = elapsed();
+      report.history.back().live_voxels = e.size();
+      timer.mark("iteration");
+      notify(it, &report.history.back());
+      if (stop) break;
     }
-    SparseVolume volume = to_volume(s.in.grid, s.set.index, e);
+    SparseVolume volume = to_volume(s.in.grid, index, e);
     finish_report(report, start, volume);
+    report.observer_seconds = observer_time;
+    report.seconds -= observer_time;
+    timer.mark("output");
     return volume;
   }
 
  private:
+  // Zeroes the voxels below prune_fraction of the largest and, once they are at least a tenth
+  // of the list, drops them from it (and from the system), so that later iterations stream
+  // only live voxels.
+  void prune(SparseSystem& system, std::vector<std::uint32_t>& index, std::vector<float>& e, std::vector<float>& acc,
+             int threads) const {
+    const std::size_t live = zero_faint(e, options_.prune_fraction, threads);
+    if (live + e.size() / 10 > e.size()) return;
+    std::vector<std::uint32_t> kept;
+    kept.reserve(live);
+    for (std::size_t n = 0; n < e.size(); ++n)
+      if (e[n] > 0.0f) kept.push_back(static_cast<std::uint32_t>(n));
+    system.compact(kept, threads);
+    for (std::size_t n = 0; n < kept.size(); ++n) {
+      index[n] = index[kept[n]];
+      e[n] = e[kept[n]];
+    }
+    index.resize(kept.size());
+    e.resize(kept.size());
+    if (!acc.empty()) acc.resize(kept.size());
+  }
+
   ReconstructionOptions options_;
   Schedule schedule_;
 };

@@ -18,7 +18,8 @@ PsfSample PsfModel::at(double z_mm) const {
   const PsfSample& b = *upper;
   const PsfSample& a = *(upper - 1);
   const double t = (z_mm - a.z_mm) / (b.z_mm - a.z_mm);
-  return {z_mm, a.sigma_u_px + t * (b.sigma_u_px - a.sigma_u_px), a.sigma_v_px + t * (b.sigma_v_px - a.sigma_v_px)};
+  return {z_mm, a.sigma_u_px + t * (b.sigma_u_px - a.sigma_u_px), a.sigma_v_px + t * (b.sigma_v_px - a.sigma_v_px),
+          a.angle_rad + t * (b.angle_rad - a.angle_rad)};
 }
 
 double PsfModel::max_sigma() const {
@@ -36,6 +37,8 @@ void PsfModel::validate(const std::string& what) const {
       throw bad_input(fmt::format("{}: sample {} has z = {} mm, not above the previous {} mm: list samples in "
                                   "strictly ascending z",
                                   what, n, s.z_mm, samples[n - 1].z_mm));
+    if (!(std::fabs(s.angle_rad) <= 3.14159265358979323846))
+      throw bad_input(fmt::format("{}: sample {} has angle = {} rad: it must be in [-pi, pi]", what, n, s.angle_rad));
     for (double sigma : {s.sigma_u_px, s.sigma_v_px})
       if (!(sigma > 0 && sigma <= 10))
         throw bad_input(fmt::format("{}: sample {} has sigma = {} px: it must be in (0, 10] px", what, n, sigma));

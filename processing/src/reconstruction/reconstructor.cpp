@@ -29,6 +29,10 @@ void ReconstructionOptions::validate() const {
   if (patch_size < 0 || patch_size > 16)
     throw bad_input(fmt::format("reconstruction: patch_size = {} must be in [1, 16] px, or 0 for ceil(4 sigma)",
                                 patch_size));
+  if (!(prune_fraction >= 0 && prune_fraction < 1))
+    throw bad_input(fmt::format("reconstruction: prune_fraction = {} must be in [0, 1) (a fraction of the largest "
+                                "intensity; 0: never prune)",
+                                prune_fraction));
   if (threads < 0) throw bad_input(fmt::format("reconstruction: threads = {} must be >= 0 (0: default)", threads));
   if (!(memory_limit_mb >= 0) || !std::isfinite(memory_limit_mb))
     throw bad_input(fmt::format("reconstruction: memory_limit_mb = {} must be >= 0 (0: MemAvailable)", memory_limit_mb));

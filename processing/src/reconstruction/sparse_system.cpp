@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include <omp.h>
+
+#include "fast_math.h"
 
 namespace tomorig::recon::detail {
 namespace {
@@ -13,76 +16,128 @@ namespace {
 // penalty. The ceiling stops a voxel whose projection has decayed to ~0 from exploding.
 constexpr float kMinLogRatio = -13.8f;  // R >= 1e-6
 constexpr float kMaxLogRatio = 6.9f;   // R <= 1e3
+// The ratio itself is clamped a little wider first, so that fast_log only sees normal floats.
+constexpr float kMinRatio = 1e-7f, kMaxRatio = 1e4f;
 // Projected intensities below this carry no information (no live voxel reaches the pixel).
 constexpr float kNoProjection = 1e-12f;
 
-// P = 0 selects the patch size at run time; 3, 4 and 5 are unrolled by the compiler.
+// Where a voxel's p x p weights come from. P = 0 selects the patch size at run time; 3, 4 and
+// 5 are unrolled by the compiler.
+//   Separable: an axis-aligned PSF, weight(a, b) = wu[a] * wv[b] from two LUT rows;
+//   Block:     a rotated PSF, a full p x p block from the 2-D LUT.
 template <int P>
-void scatter(const std::int32_t* offset, const std::uint16_t* row_u, const std::uint16_t* row_v, const float* lut_u,
-             const float* lut_v, const float* e, std::size_t begin, std::size_t end, float* image, int stride,
-             int runtime_patch) {
-  const int p = P ? P : runtime_patch;
+struct Separable {
+  const std::uint16_t* row_u;
+  const std::uint16_t* row_v;
+  const float* lut_u;
+  const float* lut_v;
+  int runtime_patch;
+
+  int p() const { return P ? P : runtime_patch; }
+  void scatter(std::size_t n, float en, float* base, int stride) const {
+    const int q = p();
+    const float* wu = lut_u + static_cast<std::size_t>(row_u[n]) * q;
+    const float* wv = lut_v + static_cast<std::size_t>(row_v[n]) * q;
+    for (int b = 0; b < q; ++b) {
+      const float ev = en * wv[b];
+      float* row = base + static_cast<std::ptrdiff_t>(b) * stride;
+      for (int a = 0; a < q; ++a) row[a] += ev * wu[a];
+    }
+  }
+  float gather(std::size_t n, const float* base, int stride) const {
+    const int q = p();
+    const float* wu = lut_u + static_cast<std::size_t>(row_u[n]) * q;
+    const float* wv = lut_v + static_cast<std::size_t>(row_v[n]) * q;
+    float s = 0.0f;
+    for (int b = 0; b < q; ++b) {
+      const float* row = base + static_cast<std::ptrdiff_t>(b) * stride;
+      float r = 0.0f;
+      for (int a = 0; a < q; ++a) r += wu[a] * row[a];
+      s += wv[b] * r;
+    }
+    return s;
+  }
+};
+
+template <int P>
+struct Block {
+  const std::uint32_t* row;
+  const float* lut;
+  int runtime_patch;
+
+  int p() const { return P ? P : runtime_patch; }
+  void scatter(std::size_t n, float en, float* base, int stride) const {
+    const int q = p();
+    const float* w = lut + static_cast<std::size_t>(row[n]) * q * q;
+    for (int b = 0; b < q; ++b) {
+      float* r = base + static_cast<std::ptrdiff_t>(b) * stride;
+      for (int a = 0; a < q; ++a) r[a] += en * w[b * q + a];
+    }
+  }
+  float gather(std::size_t n, const float* base, int stride) const {
+    const int q = p();
+    const float* w = lut + static_cast<std::size_t>(row[n]) * q * q;
+    float s = 0.0f;
+    for (int b = 0; b < q; ++b) {
+      const float* r = base + static_cast<std::ptrdiff_t>(b) * stride;
+      for (int a = 0; a < q; ++a) s += w[b * q + a] * r[a];
+    }
+    return s;
+  }
+};
+
+template <class W>
+void scatter(const W& w, const std::int32_t* offset, const float* e, std::size_t begin, std::size_t end, float* image,
+             int stride) {
   for (std::size_t n = begin; n < end; ++n) {
     const float en = e[n];
     if (en == 0.0f) continue;
-    const float* wu = lut_u + static_cast<std::size_t>(row_u[n]) * p;
-    const float* wv = lut_v + static_cast<std::size_t>(row_v[n]) * p;
-    float* base = image + offset[n];
-    for (int b = 0; b < p; ++b) {
-      const float ev = en * wv[b];
-      float* row = base + static_cast<std::ptrdiff_t>(b) * stride;
-      for (int a = 0; a < p; ++a) row[a] += ev * wu[a];
-    }
+    w.scatter(n, en, image + offset[n], stride);
   }
 }
 
-template <int P>
-inline float gather(std::int32_t offset, const float* wu, const float* wv, const float* image, int stride,
-                    int runtime_patch) {
-  const int p = P ? P : runtime_patch;
-  const float* base = image + offset;
-  float s = 0.0f;
-  for (int b = 0; b < p; ++b) {
-    const float* row = base + static_cast<std::ptrdiff_t>(b) * stride;
-    float r = 0.0f;
-    for (int a = 0; a < p; ++a) r += wu[a] * row[a];
-    s += wv[b] * r;
-  }
-  return s;
-}
-
-template <int P>
-double update_kernel(const std::int32_t* offset, const std::uint16_t* row_u, const std::uint16_t* row_v,
-                     const float* lut_u, const float* lut_v, const float* log_ratio, int stride, std::size_t voxels,
-                     float* e, float mu, int threads, int runtime_patch) {
-  const int p = P ? P : runtime_patch;
+template <class W>
+double update_kernel(const W& w, const std::int32_t* offset, const float* log_ratio, int stride, std::size_t voxels,
+                     float* e, float mu, int threads) {
   double sum = 0.0;
   const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(voxels);
 #pragma omp parallel for num_threads(threads) schedule(static) reduction(+ : sum)
   for (std::ptrdiff_t n = 0; n < count; ++n) {
     if (e[n] == 0.0f) continue;
-    const float s = gather<P>(offset[n], lut_u + static_cast<std::size_t>(row_u[n]) * p,
-                              lut_v + static_cast<std::size_t>(row_v[n]) * p, log_ratio, stride, p);
-    const float factor = std::exp(mu * s);
+    const float factor = fast_exp(mu * w.gather(static_cast<std::size_t>(n), log_ratio + offset[n], stride));
     e[n] *= factor;
     sum += std::fabs(1.0f - factor);
   }
   return sum;
 }
 
-template <int P>
-void accumulate_kernel(const std::int32_t* offset, const std::uint16_t* row_u, const std::uint16_t* row_v,
-                       const float* lut_u, const float* lut_v, const float* log_ratio, int stride,
-                       std::size_t voxels, float* acc, int threads, int runtime_patch) {
-  const int p = P ? P : runtime_patch;
+template <class W>
+void accumulate_kernel(const W& w, const std::int32_t* offset, const float* log_ratio, int stride, std::size_t voxels,
+                       float* acc, int threads) {
   const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(voxels);
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (std::ptrdiff_t n = 0; n < count; ++n)
-    acc[n] += gather<P>(offset[n], lut_u + static_cast<std::size_t>(row_u[n]) * p,
-                        lut_v + static_cast<std::size_t>(row_v[n]) * p, log_ratio, stride, p);
+    acc[n] += w.gather(static_cast<std::size_t>(n), log_ratio + offset[n], stride);
 }
 
 }  // namespace
+
+template <class F>
+void SparseSystem::with_weights(const Camera& cam, F&& kernel) const {
+  // One instantiation per patch size the compiler can unroll, and a run-time one for the rest.
+  auto dispatch = [&](auto patch_constant) {
+    constexpr int P = decltype(patch_constant)::value;
+    if (cam.rotated)
+      kernel(Block<P>{cam.row_2d.data(), cam.block_weights.table(), patch_});
+    else
+      kernel(Separable<P>{cam.row_u.data(), cam.row_v.data(), cam.u_weights.table(), cam.v_weights.table(), patch_});
+  };
+  switch (patch_) {
+    case 3: dispatch(std::integral_constant<int, 3>{}); break;
+    case 5: dispatch(std::integral_constant<int, 5>{}); break;
+    default: dispatch(std::integral_constant<int, 0>{}); break;
+  }
+}
 
 SparseSystem::SparseSystem(const PreparedInput& in, const ActiveSet& set, int patch, int lut_steps)
     : patch_(patch), voxels_(set.size()) {
@@ -105,18 +160,30 @@ SparseSystem::SparseSystem(const PreparedInput& in, const ActiveSet& set, int pa
     cam.projection.assign(size, 0.0f);
     cam.log_ratio.assign(size, 0.0f);
 
+    std::vector<PsfSample> psf_of_slice(static_cast<std::size_t>(g.nz));
     std::vector<double> sigma_u(g.nz), sigma_v(g.nz);
     for (int k = 0; k < g.nz; ++k) {
       const PsfSample s = in.psf[c].at(g.origin.z + k * g.voxel_size);
+      psf_of_slice[static_cast<std::size_t>(k)] = s;
       sigma_u[k] = s.sigma_u_px;
       sigma_v[k] = s.sigma_v_px;
+      cam.rotated = cam.rotated || is_rotated(s);
     }
-    cam.u_weights = AxisWeights(sigma_u, patch, lut_steps);
-    cam.v_weights = AxisWeights(sigma_v, patch, lut_steps);
+    if (cam.rotated) {
+      // Placement and phase from one-level axis tables (their row is the phase), weights
+      // from the 2-D table.
+      cam.u_weights = AxisWeights(std::vector<double>(1, 1.0), patch, lut_steps);
+      cam.v_weights = cam.u_weights;
+      cam.block_weights = PatchWeights(psf_of_slice, patch, lut_steps, in.threads);
+      cam.row_2d.resize(voxels_);
+    } else {
+      cam.u_weights = AxisWeights(sigma_u, patch, lut_steps);
+      cam.v_weights = AxisWeights(sigma_v, patch, lut_steps);
+      cam.row_u.resize(voxels_);
+      cam.row_v.resize(voxels_);
+    }
 
     cam.offset.resize(voxels_);
-    cam.row_u.resize(voxels_);
-    cam.row_v.resize(voxels_);
     const float* u = set.u[c].data();
     const float* v = set.v[c].data();
     const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(voxels_);
@@ -124,8 +191,15 @@ SparseSystem::SparseSystem(const PreparedInput& in, const ActiveSet& set, int pa
     for (std::ptrdiff_t n = 0; n < count; ++n) {
       const int k = static_cast<int>(set.index[n] / plane);
       int su = 0, sv = 0;
-      cam.u_weights.locate(u[n], k, su, cam.row_u[n]);
-      cam.v_weights.locate(v[n], k, sv, cam.row_v[n]);
+      if (cam.rotated) {
+        std::uint16_t qu = 0, qv = 0;
+        cam.u_weights.locate(u[n], 0, su, qu);
+        cam.v_weights.locate(v[n], 0, sv, qv);
+        cam.row_2d[n] = cam.block_weights.row(k, qu, qv);
+      } else {
+        cam.u_weights.locate(u[n], k, su, cam.row_u[n]);
+        cam.v_weights.locate(v[n], k, sv, cam.row_v[n]);
+      }
       // Active voxels image inside every camera, so this clamp never moves one; it only
       // guarantees that no patch can reach outside the padded image.
       su = std::clamp(su, -cam.pad, cam.width + cam.pad - patch);
@@ -144,6 +218,25 @@ double SparseSystem::estimate_bytes(const PreparedInput& in, std::size_t voxels,
   const double per_voxel = 16.0 + cams * (8.0 + 8.0);
   return per_voxel * static_cast<double>(voxels) + image_bytes(in, 3, patch + 1) +
          image_bytes(in, 1, patch + 1) / cams * std::max(0, threads - 1);
+}
+
+void SparseSystem::compact(const std::vector<std::uint32_t>& kept, int threads) {
+  // In place: kept[n] >= n, so every entry is read before it can be overwritten.
+  const int cams = static_cast<int>(cams_.size());
+#pragma omp parallel for num_threads(threads) schedule(static, 1)
+  for (int c = 0; c < cams; ++c) {
+    Camera& cam = cams_[static_cast<std::size_t>(c)];
+    auto keep = [&](auto& values) {
+      if (values.empty()) return;
+      for (std::size_t n = 0; n < kept.size(); ++n) values[n] = values[kept[n]];
+      values.resize(kept.size());
+    };
+    keep(cam.offset);
+    keep(cam.row_u);
+    keep(cam.row_v);
+    keep(cam.row_2d);
+  }
+  voxels_ = kept.size();
 }
 
 bool SparseSystem::inside(std::size_t c, std::int32_t pixel) const {
@@ -166,14 +259,9 @@ PixelResidual SparseSystem::project(std::size_t c, const float* e, int threads) 
     float* image = t == 0 ? cam.projection.data() : scratch_[t - 1].data();
     std::fill(image, image + size, 0.0f);
     const std::size_t begin = voxels_ * t / nt, end = voxels_ * (t + 1) / nt;
-    const float* lu = cam.u_weights.table();
-    const float* lv = cam.v_weights.table();
-    switch (patch_) {
-      case 3: scatter<3>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, e, begin, end, image, cam.stride, patch_); break;
-      case 4: scatter<4>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, e, begin, end, image, cam.stride, patch_); break;
-      case 5: scatter<5>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, e, begin, end, image, cam.stride, patch_); break;
-      default: scatter<0>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, e, begin, end, image, cam.stride, patch_); break;
-    }
+    with_weights(cam, [&](const auto& w) {
+      scatter(w, cam.offset.data(), e, begin, end, image, cam.stride);
+    });
 #pragma omp barrier
 #pragma omp for schedule(static) reduction(+ : abs_difference, measured)
     for (int y = 0; y < rows; ++y) {
@@ -195,7 +283,8 @@ PixelResidual SparseSystem::project(std::size_t c, const float* e, int threads) 
         row_meas += i_meas;
         float l = 0.0f;
         if (i_proj > kNoProjection)
-          l = i_meas > 0.0f ? std::clamp(std::log(i_meas / i_proj), kMinLogRatio, kMaxLogRatio) : kMinLogRatio;
+          l = i_meas > 0.0f ? std::clamp(fast_log(std::clamp(i_meas / i_proj, kMinRatio, kMaxRatio)), kMinLogRatio, kMaxLogRatio)
+                             : kMinLogRatio;
         lr[x] = l;
       }
       abs_difference += row_diff;
@@ -207,26 +296,18 @@ PixelResidual SparseSystem::project(std::size_t c, const float* e, int threads) 
 
 double SparseSystem::update(std::size_t c, float* e, float mu, int threads) const {
   const Camera& cam = cams_[c];
-  const float* lu = cam.u_weights.table();
-  const float* lv = cam.v_weights.table();
-  switch (patch_) {
-    case 3: return update_kernel<3>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, cam.log_ratio.data(), cam.stride, voxels_, e, mu, threads, patch_);
-    case 4: return update_kernel<4>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, cam.log_ratio.data(), cam.stride, voxels_, e, mu, threads, patch_);
-    case 5: return update_kernel<5>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, cam.log_ratio.data(), cam.stride, voxels_, e, mu, threads, patch_);
-    default: return update_kernel<0>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, cam.log_ratio.data(), cam.stride, voxels_, e, mu, threads, patch_);
-  }
+  double sum = 0.0;
+  with_weights(cam, [&](const auto& w) {
+    sum = update_kernel(w, cam.offset.data(), cam.log_ratio.data(), cam.stride, voxels_, e, mu, threads);
+  });
+  return sum;
 }
 
 void SparseSystem::accumulate(std::size_t c, float* acc, int threads) const {
   const Camera& cam = cams_[c];
-  const float* lu = cam.u_weights.table();
-  const float* lv = cam.v_weights.table();
-  switch (patch_) {
-    case 3: accumulate_kernel<3>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, cam.log_ratio.data(), cam.stride, voxels_, acc, threads, patch_); break;
-    case 4: accumulate_kernel<4>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, cam.log_ratio.data(), cam.stride, voxels_, acc, threads, patch_); break;
-    case 5: accumulate_kernel<5>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, cam.log_ratio.data(), cam.stride, voxels_, acc, threads, patch_); break;
-    default: accumulate_kernel<0>(cam.offset.data(), cam.row_u.data(), cam.row_v.data(), lu, lv, cam.log_ratio.data(), cam.stride, voxels_, acc, threads, patch_); break;
-  }
+  with_weights(cam, [&](const auto& w) {
+    accumulate_kernel(w, cam.offset.data(), cam.log_ratio.data(), cam.stride, voxels_, acc, threads);
+  });
 }
 
 }  // namespace tomorig::recon::detail

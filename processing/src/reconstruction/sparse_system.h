@@ -40,16 +40,25 @@ class SparseSystem {
   // SMART: acc_j += sum_i w_ij ln R_i (the caller applies exp(mu * acc / cameras)).
   void accumulate(std::size_t c, float* acc, int threads) const;
 
+  // Keeps only the voxels at positions `kept` (ascending), in that order.
+  void compact(const std::vector<std::uint32_t>& kept, int threads);
+
   // Row-by-row (classical MART) access: the patch of voxel n in camera c.
   struct Patch {
     std::int32_t offset;  // padded-image index of the patch's first pixel
-    const float* wu;      // p weights along u
-    const float* wv;      // p weights along v
+    const float* wu;      // p weights along u (axis-aligned PSF), else null
+    const float* wv;      // p weights along v (axis-aligned PSF), else null
+    const float* block;   // p x p weights, v-major (rotated PSF), else null
+    int p;
+    float weight(int a, int b) const { return block ? block[b * p + a] : wu[a] * wv[b]; }
   };
   Patch patch_of(std::size_t c, std::size_t n) const {
     const Camera& cam = cams_[c];
+    if (cam.rotated)
+      return {cam.offset[n], nullptr, nullptr,
+              cam.block_weights.table() + static_cast<std::size_t>(cam.row_2d[n]) * patch_ * patch_, patch_};
     return {cam.offset[n], cam.u_weights.table() + static_cast<std::size_t>(cam.row_u[n]) * patch_,
-            cam.v_weights.table() + static_cast<std::size_t>(cam.row_v[n]) * patch_};
+            cam.v_weights.table() + static_cast<std::size_t>(cam.row_v[n]) * patch_, nullptr, patch_};
   }
   int patch() const { return patch_; }
   int stride(std::size_t c) const { return cams_[c].stride; }
@@ -64,9 +73,15 @@ class SparseSystem {
     std::vector<float> projection;  // padded
     std::vector<float> log_ratio;   // padded, 0 in the padding: no information, no update
     std::vector<std::int32_t> offset;
-    std::vector<std::uint16_t> row_u, row_v;
+    std::vector<std::uint16_t> row_u, row_v;  // axis-aligned PSF: LUT rows along u and v
     AxisWeights u_weights, v_weights;
+    bool rotated = false;                     // rotated PSF: one 2-D LUT row per voxel instead
+    std::vector<std::uint32_t> row_2d;
+    PatchWeights block_weights;
   };
+  // Calls kernel(w) with the camera's weight source (see sparse_system.cpp).
+  template <class F>
+  void with_weights(const Camera& cam, F&& kernel) const;
 
   int patch_ = 0;
   std::size_t voxels_ = 0;

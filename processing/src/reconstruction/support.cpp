@@ -7,6 +7,7 @@
 
 #include "mlos.h"
 #include "sparse_system.h"
+#include "stage_timer.h"
 #include "system_memory.h"
 
 namespace tomorig::recon::detail {
@@ -18,8 +19,10 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 Support build_support(const ReconstructionInput& input, const ReconstructionOptions& options, const SupportNeeds& needs,
                       ReconstructionReport& report) {
   const auto start = std::chrono::steady_clock::now();
+  StageTimer timer("support");
   Support s;
   s.in = prepare_input(input, options);
+  timer.mark("prepare_input");
   report.threads = s.in.threads;
   double sigma = 0;
   for (const PsfModel& psf : s.in.psf) sigma = std::max(sigma, psf.max_sigma());
@@ -59,7 +62,9 @@ Support build_support(const ReconstructionInput& input, const ReconstructionOpti
                  fmt::format("a grid of {} x {} x {} voxels (up to {:.1f} % of them active)", s.in.grid.nx, s.in.grid.ny,
                              s.in.grid.nz, 100.0 * expected_fraction));
 
+  timer.mark("memory estimate");
   const GridProjector projector(s.in);
+  timer.mark("grid projector");
   MlosSettings mlos;
   mlos.threshold = needs.mlos_threshold;
   mlos.keep_positions = needs.positions;
@@ -67,6 +72,7 @@ Support build_support(const ReconstructionInput& input, const ReconstructionOpti
   mlos.bytes_per_voxel = per_voxel;
   mlos.memory_limit_mb = options.memory_limit_mb;
   s.set = run_mlos(s.in, projector, mlos);
+  timer.mark("mlos");
   report.active_voxels = s.set.size();
   report.estimated_memory_mb = (fixed + per_voxel * static_cast<double>(s.set.size())) / (1024.0 * 1024.0);
   report.setup_seconds = seconds_since(start);

@@ -42,6 +42,36 @@ class AxisWeights {
   std::vector<std::uint16_t> slice_level_;
 };
 
+// Weights of a rotated elliptical PSF (Eq. 3.8 with b != 0), which is not separable: per
+// level (distinct sigma_u, sigma_v, angle) and sub-pixel phase pair (qu, qv) a full p x p block
+// of the Gaussian integrated over each pixel (8 x 8 sub-samples). The phases are those of an
+// AxisWeights with a single level (its row is the phase), so the patch placement is the same
+// as in the separable case.
+class PatchWeights {
+ public:
+  PatchWeights() = default;
+  PatchWeights(const std::vector<PsfSample>& psf_of_slice, int patch, int steps, int threads);
+
+  std::uint32_t row(int k, int qu, int qv) const {
+    return (static_cast<std::uint32_t>(slice_level_[k]) * steps_ + static_cast<std::uint32_t>(qv)) * steps_ +
+           static_cast<std::uint32_t>(qu);
+  }
+  const float* table() const { return weights_.data(); }  // row r: p * p weights, v-major
+  int levels() const { return levels_; }
+
+ private:
+  int patch_ = 0, steps_ = 0, levels_ = 0;
+  std::vector<float> weights_;
+  std::vector<std::uint32_t> slice_level_;
+};
+
+// Whether a PSF needs PatchWeights: a rotation angle away from 0 (and from +-pi) at any depth.
+bool is_rotated(const PsfSample& psf);
+
+// Weight of the pixel whose centre lies at (du, dv) from the image position, for a rotated
+// elliptical Gaussian: integrated over the pixel by n x n midpoint sub-samples.
+double pixel_integrated_gaussian_2d(double du, double dv, const PsfSample& psf, int n = 8);
+
 // Weight of the pixel at signed distance d (pixel centre minus image position) for sigma.
 double pixel_integrated_gaussian(double d, double sigma);
 

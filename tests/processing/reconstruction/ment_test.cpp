@@ -73,21 +73,23 @@ TEST(Ment, IterationsReduceTheResidual) {
     std::printf("iteration %d: residual %.4f, mean update %.4f\n", h.iteration, h.residual, h.mean_update);
 }
 
-TEST(Ment, MemoryIsImagesPlusSparseOutputNeverTheDenseVolume) {
+TEST(Ment, MemoryIsImagesPlusTheSupportNeverTheDenseVolume) {
   // The same images on a grid 3x deeper than the particle slab: 96 x 96 x 96 voxels, 3.4 MB as
-  // a dense float volume, of which MENT may hold only the images and the non-zero voxels.
+  // a dense float volume. MENT may hold the images, the sample list of the support (16 B per
+  // sample for 4 cameras, 2 samples per support voxel, plus its 4 B grid index) and the
+  // non-zero output (8 B per voxel): memory that grows with the support, not with the grid.
   recon::ReconstructionInput in = ment_case().input();
   VoxelGrid deep = VoxelGrid::centred(96, 96, 96, in.grid.voxel_size);
   in.grid = deep;
-  ReconstructionReport report;
+  ReconstructionReport report, mlos_report;
   // Two threads: each thread keeps one accumulator image, so the fixed part grows with them.
   const SparseVolume v = run("ment", in, report, 1, 2);
+  run("mlos", in, mlos_report, 1, 2);  // the same support criterion: its size bounds MENT's list
   const double dense_mb = static_cast<double>(deep.voxel_count()) * 4.0 / (1024.0 * 1024.0);
-  // The images: (3 + threads) padded planes of 112 x 112 floats per camera, fixed by the
-  // cameras whatever the grid; the rest must be the sparse output, 8 bytes per non-zero voxel.
   const double images_mb = 4.0 * (3 + 2) * 112.0 * 112.0 * 4.0 / (1024.0 * 1024.0);
+  const double support_mb = 1.05 * static_cast<double>(mlos_report.active_voxels) * (2 * 16 + 4) / (1024.0 * 1024.0);
   const double output_mb = static_cast<double>(v.size()) * 8.0 / (1024.0 * 1024.0);
-  EXPECT_LE(report.estimated_memory_mb, images_mb + output_mb + 1e-6);
+  EXPECT_LE(report.estimated_memory_mb, images_mb + support_mb + output_mb + 1e-6);
   EXPECT_LT(output_mb, 0.6 * dense_mb);
   EXPECT_LT(static_cast<double>(v.size()), 0.3 * static_cast<double>(deep.voxel_count()));
 }

@@ -57,6 +57,10 @@ class Camera {
   // Stops delivery; after it returns the sink is not called again. Idempotent.
   virtual void stop() = 0;
   virtual StreamStatistics statistics() const = 0;
+  // False once the camera is known to be gone (unplugged, powered off, stopped answering).
+  // Its frames then go missing in the assembler, where they are counted; the rig decides
+  // whether to go on without it. Backends that cannot tell report true.
+  virtual bool connected() const { return true; }
 };
 
 }  // namespace tomorig::acquisition

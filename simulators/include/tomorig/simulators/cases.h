@@ -48,5 +48,6 @@ const CaseDefinition& find_case(std::string_view name);
 
 // The individual cases (one .cpp each).
 CaseDefinition tpiv_thesis_case();
+CaseDefinition size_thesis_spray_case();
 
 }  // namespace tomorig::sim

@@ -69,6 +69,12 @@ class SimulatedRig {
   std::vector<Vec3d> particle_midpoints(std::uint64_t set_index) const;
   // Renders set k: a fresh particle field, moved by the flow, imaged by every camera.
   SimulatedSet render_set(std::uint64_t set_index) const;
+  // Renders set k as triggered with an actual pulse separation `dt_ns` (a live rig's event,
+  // jitter included): the flow's displacement scales with dt_ns / options().dt_ns, so a Δt
+  // error shows up as a displacement error. The set records dt_ns, and frame B is stamped at
+  // trigger time + dt_ns. With dt_ns == options().dt_ns it equals render_set(k) bit for bit.
+  // Throws bad_input for dt_ns < 0, or dt_ns != 0 when options().dt_ns is 0 (no time base).
+  SimulatedSet render_set(std::uint64_t set_index, std::int64_t dt_ns) const;
   // The noise-free float signal of camera `camera` for the given particles (for tests and
   // diagnostics; render_set digitises exactly this).
   Image render_signal(std::size_t camera, std::span<const Vec3d> particles) const;

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "tomorig/core/error.h"
 #include "tomorig/core/frame_set.h"
 #include "tomorig/core/geometry.h"
 #include "tomorig/core/pixel_format.h"
@@ -86,6 +87,14 @@ struct FlushPolicy {
   double every_seconds = 1.0;
 };
 
+// Thrown by SessionWriter::append() when the disk holding the session has no room for the set
+// (see SessionWriterOptions::disk_reserve_bytes). Nothing of the set was written and the writer
+// stays usable: finish() closes a complete, valid session with every set appended before.
+class DiskFullError : public Error {
+ public:
+  explicit DiskFullError(const std::string& message) : Error(ErrorKind::runtime, message) {}
+};
+
 struct SessionWriterOptions {
   Compression compression = Compression::none;
   bool overwrite = false;  // replace an existing file at the final path
@@ -96,6 +105,12 @@ struct SessionWriterOptions {
   // by finish(). Without `live`, an unfinished file is deleted: nothing half-written remains.
   bool live = false;
   FlushPolicy flush;
+  // Space the disk must keep free, in bytes, beyond the set being appended and the truth held
+  // for finish(). When the next set would eat into it, append() throws DiskFullError before
+  // writing, so the session can still be finished cleanly (HDF5 itself cannot recover from a
+  // write that hits a full disk: such a failure leaves only "<path>.partial", valid up to its
+  // last flush). 0: no check.
+  std::uint64_t disk_reserve_bytes = 0;
 };
 
 class SessionWriter {

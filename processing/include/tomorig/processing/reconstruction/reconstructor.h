@@ -13,6 +13,7 @@
 //   recon::ReconstructionReport report;
 //   SparseVolume v = r->reconstruct(input, report);   // v.to_dense() for a dense export
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -66,6 +67,11 @@ struct ReconstructionOptions {
   // Edge of the square pixel patch each voxel spreads over; 0: ceil(4 sigma_max) (Sect. 3.1.3),
   // rounded up to an odd number >= 3 so that the patch is centred on the voxel's image.
   int patch_size = 0;
+  // SMART/FMART: after each iteration, voxels whose intensity fell below this fraction of the
+  // largest intensity are set to 0 and dropped from the voxel list, so later iterations only
+  // visit the live ones (ghosts decay by orders of magnitude within 1-2 iterations). 0 keeps
+  // every MLOS voxel to the end.
+  double prune_fraction = 0.0;
   // OpenMP threads; 0: the OpenMP default. Results do not depend on it beyond rounding order.
   int threads = 0;
   // Memory the reconstruction may use, MB; 0: 80 % of MemAvailable from /proc/meminfo. The estimate is
@@ -81,6 +87,8 @@ struct IterationStats {
   double residual = 0.0;     // sum |I - I~| / sum I over all cameras' pixels (projections of this iteration)
   double mean_update = 0.0;  // mean |1 - P_j| over active voxels and cameras
   double seconds = 0.0;      // wall time of this iteration
+  double elapsed_seconds = 0.0;  // since the start of reconstruct(), observer time excluded
+  std::size_t live_voxels = 0;   // voxels still in the list after this iteration (pruning)
 };
 
 struct ReconstructionReport {
@@ -90,7 +98,8 @@ struct ReconstructionReport {
   std::size_t active_voxels = 0;     // voxels carried by the sparse support (after MLOS)
   std::size_t nonzero_voxels = 0;    // voxels > 0 in the result
   double setup_seconds = 0.0;        // input checks, MLOS and the projection set-up
-  double seconds = 0.0;              // whole call
+  double seconds = 0.0;              // whole call, without the time spent in the iteration observer
+  double observer_seconds = 0.0;     // time spent in the iteration observer (not in `seconds`)
   double peak_rss_mb = 0.0;          // VmHWM of the process at the end of the call
   double estimated_memory_mb = 0.0;  // the estimate checked against the limit
   int threads = 0;                   // threads used
@@ -98,13 +107,31 @@ struct ReconstructionReport {
   std::string brief() const;  // one line for logs
 };
 
+// What an iteration observer sees (e.g. a benchmark recording Q per iteration). `iteration` 0
+// is the initial volume (MLOS) before the first iteration; `stats` is null then. `volume()`
+// builds the current volume on request only. The time spent in the observer is excluded from
+// every time in the report.
+struct IterationView {
+  int iteration = 0;
+  const IterationStats* stats = nullptr;
+  double elapsed_seconds = 0.0;  // since the start of reconstruct(), observer time excluded
+  std::function<SparseVolume()> volume;
+};
+using IterationObserver = std::function<void(const IterationView&)>;
+
 class Reconstructor {
  public:
   virtual ~Reconstructor() = default;
+  // Called after the set-up (iteration 0) and after every iteration by SMART and FMART; the
+  // other algorithms ignore it.
+  void set_iteration_observer(IterationObserver observer) { observer_ = std::move(observer); }
   virtual std::string name() const = 0;
   // Throws tomorig::Error: bad_input for inconsistent, empty or non-finite input or a volume
   // too large for memory; the report is filled on success.
   virtual SparseVolume reconstruct(const ReconstructionInput& input, ReconstructionReport& report) = 0;
+
+ protected:
+  IterationObserver observer_;
 };
 
 // Throws tomorig::Error (bad_input) for an invalid option or an unknown algorithm.

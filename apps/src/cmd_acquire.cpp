@@ -1,0 +1,195 @@
+// tomorig acquire: the acquisition half of a split rig. Trigger device, cameras and FrameSet
+// assembly as in `tomorig run`, but the sets leave over the lossless ZeroMQ stream (PUSH) for a
+// `tomorig record` in another process, possibly on another host. It binds by default (the
+// recorder connects); a full recorder slows acquisition down (back-pressure), it never drops.
+#include <cerrno>
+#include <chrono>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+#include <zmq.hpp>
+
+#include "commands.h"
+#include "record_layout.h"
+#include "rig_acquisition.h"
+#include "rig_status.h"
+#include "stop_signal.h"
+#include "tomorig/config/rig_config.h"
+#include "tomorig/core/error.h"
+#include "tomorig/stream/frame_sender.h"
+
+namespace tomorig::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using std::chrono::duration;
+using std::chrono::duration_cast;
+
+struct AcquireOptions {
+  std::string config_path;
+  std::string to = "tcp://127.0.0.1:5555";
+  bool connect = false;
+  bool allow_remote = false;
+  std::optional<std::uint64_t> sets;
+  std::optional<double> duration_s;
+  std::string pace = "real-time";
+  std::string on_camera_loss = "stop";
+  std::vector<std::string> faults;
+  std::string status = "tcp://127.0.0.1:5556";
+  double timeout_s = 10.0;
+  double wait_s = 60.0;
+};
+
+double seconds_since(Clock::time_point t) { return duration<double>(Clock::now() - t).count(); }
+
+trigger::Pacing parse_pace(const std::string& text) {
+  if (text == "real-time") return trigger::Pacing::real_time;
+  if (text == "max") return trigger::Pacing::as_fast_as_consumed;
+  throw bad_input(fmt::format("--pace {} is not supported: use real-time or max", text));
+}
+
+// Sends one set, retrying while the recorder is absent or slow, up to `limit_s`; false if
+// `stop` (when given) was requested meanwhile and the set was not sent.
+bool send_set(stream::FrameSender& sender, const FrameSet& set, double limit_s, const StopSignalGuard* stop) {
+  const auto begin = Clock::now();
+  for (;;) {
+    try {
+      if (sender.send(set)) return true;
+    } catch (const zmq::error_t& e) {
+      if (e.num() != EINTR)
+        throw runtime_error(fmt::format("sending set {} on {} failed: {}", set.set_index, sender.endpoint(), e.what()));
+    }
+    if (stop != nullptr && stop->stop_requested()) return false;
+    if (seconds_since(begin) >= limit_s)
+      throw runtime_error(fmt::format(
+          "no recorder took set {} within {:g} s on {}: is 'tomorig record --from {}' running? (raise --timeout for a "
+          "slow recorder, or --wait for the first set)",
+          set.set_index, limit_s, sender.endpoint(), sender.endpoint()));
+  }
+}
+
+void acquire(const AcquireOptions& opt) {
+  if (!(opt.timeout_s > 0.0) || !(opt.wait_s > 0.0))
+    throw bad_input(fmt::format("--timeout {:g} / --wait {:g} are invalid: both must be > 0 seconds", opt.timeout_s,
+                                opt.wait_s));
+  if (opt.sets && *opt.sets < 1) throw bad_input(fmt::format("--sets {} is invalid: must be >= 1", *opt.sets));
+  const config::RigConfig rig = opt.config_path.empty() ? config::default_rig_config()
+                                                        : config::load_rig_config(opt.config_path);
+  const auto loss_policy = parse_camera_loss_policy(opt.on_camera_loss);
+  if (!loss_policy)
+    throw bad_input(fmt::format("--on-camera-loss {} is not supported: use stop or continue", opt.on_camera_loss));
+
+  RigAcquisitionOptions acquisition;
+  acquisition.sets = opt.sets;
+  acquisition.duration_s = opt.duration_s;
+  if (!opt.sets && !opt.duration_s && rig.simulation && rig.simulation->sets > 0)
+    acquisition.sets = static_cast<std::uint64_t>(rig.simulation->sets);
+  acquisition.pacing = parse_pace(opt.pace);
+  acquisition.on_camera_loss = *loss_policy;
+  for (const auto& fault : opt.faults) add_camera_fault(acquisition.faults, fault);
+  RigAcquisition rig_run(rig, acquisition);  // a bad rig fails here, before anything is sent
+
+  StopSignalGuard stop;
+  zmq::context_t context(1);
+  stream::SocketOptions socket;
+  socket.endpoint = {opt.to, !opt.connect, opt.allow_remote};
+  socket.timeout = duration_cast<std::chrono::milliseconds>(duration<double>(opt.timeout_s));
+  auto sender = std::make_unique<stream::FrameSender>(context, socket);
+  // The first line names the real endpoint (a "*" port resolved), for scripts and tests.
+  fmt::print(stderr, "acquire: {} {}, rig '{}', {} cameras, {}\n", opt.connect ? "connected to" : "sending on",
+             sender->endpoint(), rig.name, rig.cameras.size(),
+             acquisition.sets ? fmt::format("{} sets", *acquisition.sets)
+                              : (opt.duration_s ? fmt::format("{:g} s", *opt.duration_s) : std::string("until Ctrl-C")));
+  std::fflush(stderr);
+  StatusReporter status("acquire", context, opt.status);
+  if (!status.endpoint().empty()) fmt::print(stderr, "acquire: status JSON on {}\n", status.endpoint());
+
+  LossTally losses(rig_run.camera_ids());
+  StatusFigures figures;
+  figures.total = acquisition.sets;
+  figures.to_disk = false;
+  auto refresh = [&](bool final) {
+    const RigProgress progress = rig_run.progress();
+    figures.queue_depth = progress.queued_sets;
+    figures.dropped_trigger_events = progress.dropped_trigger_events;
+    status.update(figures, losses, final);
+  };
+  std::string stopped_by;
+  rig_run.start();
+  while (!rig_run.done()) {
+    for (const auto& text : rig_run.take_notices()) {
+      status.break_line();
+      fmt::print(stderr, "acquire: {}\n", text);
+    }
+    if (stopped_by.empty() && stop.stop_requested()) {
+      stopped_by = stop.signal_name();
+      figures.state = "stopping";
+      rig_run.request_stop();
+    }
+    std::optional<FrameSet> set = rig_run.pop(std::chrono::milliseconds(100));
+    if (!set) {
+      refresh(false);
+      continue;
+    }
+    const bool first = sender->stats().sets_sent == 0;
+    // Ctrl-C interrupts a wait for the recorder; the set in hand and those already acquired
+    // still go out, each with the normal timeout.
+    if (!send_set(*sender, *set, first ? opt.wait_s : opt.timeout_s, stopped_by.empty() ? &stop : nullptr)) {
+      stopped_by = stop.signal_name();
+      figures.state = "stopping";
+      rig_run.request_stop();
+      send_set(*sender, *set, opt.timeout_s, nullptr);
+    }
+    losses.add(*set);
+    ++figures.sets;
+    figures.bytes += pixel_bytes(*set);
+    refresh(false);
+  }
+  for (const auto& text : rig_run.take_notices()) fmt::print(stderr, "acquire: {}\n", text);
+  rig_run.request_stop();
+
+  // Hand every queued set to the transport: closing the context waits (up to one --timeout of
+  // linger) until ZeroMQ has written them to the recorder.
+  const stream::SenderStats sent = sender->stats();
+  const std::string endpoint = sender->endpoint();
+  sender.reset();
+  figures.state = rig_run.failure().empty() ? "stopped" : "failed";
+  refresh(true);
+  fmt::print("acquired and sent {} sets ({:.1f} MB) on {}; {} lost frames, {} incomplete sets{}\n", sent.sets_sent,
+             static_cast<double>(sent.bytes_sent) / 1e6, endpoint, losses.frames_lost(), losses.incomplete_sets(),
+             stopped_by.empty() ? "" : fmt::format(", stopped by {}", stopped_by));
+  if (!rig_run.failure().empty()) throw runtime_error(rig_run.failure());
+}
+
+}  // namespace
+
+void add_acquire_command(CLI::App& root) {
+  auto opt = std::make_shared<AcquireOptions>();
+  CLI::App* cmd = root.add_subcommand(
+      "acquire", "Run trigger and cameras and stream the frame sets to 'tomorig record' (binds; the recorder connects)");
+  cmd->add_option("-c,--config", opt->config_path, "Rig file (TOML); default: the embedded rig")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--to", opt->to, "Stream endpoint (tcp://127.0.0.1:* picks a free port)")->capture_default_str();
+  cmd->add_flag("--connect", opt->connect, "Connect --to instead of binding (the recorder binds)");
+  cmd->add_flag("--allow-remote", opt->allow_remote, "Allow binding --to on a non-loopback address");
+  auto* sets = cmd->add_option("--sets", opt->sets,
+                               "Number of sets (default: simulation.sets of a simulated rig, else until Ctrl-C)");
+  cmd->add_option("--duration", opt->duration_s, "Acquire for this many seconds")->excludes(sets);
+  cmd->add_option("--pace", opt->pace, "Simulated trigger: real-time | max (as fast as the recorder takes them)")
+      ->capture_default_str();
+  cmd->add_option("--on-camera-loss", opt->on_camera_loss, "When a camera vanishes: stop | continue")
+      ->capture_default_str();
+  cmd->add_option("--status", opt->status, "Where the JSON status PUB socket binds; none: no socket")
+      ->capture_default_str();
+  cmd->add_option("--timeout", opt->timeout_s, "Seconds a send may wait for the recorder before giving up")
+      ->capture_default_str();
+  cmd->add_option("--wait", opt->wait_s, "Seconds to wait for a recorder before the first set")->capture_default_str();
+  cmd->add_option("--inject-fault", opt->faults,
+                  "Testing: make a simulated camera fail, CAMERA:vanish-after=EVENTS (repeatable)");
+  cmd->callback([opt] { acquire(*opt); });
+}
+
+}  // namespace tomorig::app

@@ -1,0 +1,21 @@
+#pragma once
+// XDMF 3 text for a results file: one uniform grid per set (displacement, velocity, status,
+// peak) and one for the ensemble statistics, all node-centred on the interrogation grid.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "tomorig/core/geometry.h"
+
+namespace tomorig::storage {
+
+struct XdmfFieldGrid {
+  int nx = 0, ny = 0, nz = 0;
+  Vec3d origin, spacing;  // mm
+};
+
+// `file_name`: the HDF5 file's name relative to the .xdmf; `sets`: the set names under /sets.
+std::string xdmf_for_results(const std::string& file_name, const XdmfFieldGrid& grid,
+                             const std::vector<std::string>& sets, bool has_statistics);
+
+}  // namespace tomorig::storage

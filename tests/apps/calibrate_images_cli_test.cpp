@@ -1,0 +1,154 @@
+// `tomorig calibrate --images / --image-list`: dot-grid target images rendered from known
+// pinhole cameras go in; the detected points, the fitted models and the per-plane report must
+// match those cameras; bad input (different image sizes within a camera, one plane, too few
+// points, no origin marker, a fit that does not converge) is an error naming camera and plane.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+
+#include "../processing/calibration/dot_grid_render.h"
+#include "cli_runner.h"
+#include "tomorig/processing/calibration/calibration_file.h"
+#include "tomorig/storage/image_file.h"
+
+namespace tomorig::testing {
+namespace {
+
+namespace fs = std::filesystem;
+using calibration::PinholeCamera;
+using dot_grid_test::TargetDrawing;
+
+constexpr int kWidth = 320, kHeight = 288;
+const std::vector<double> kPlanes = {-3, -1, 1, 3};
+
+std::vector<PinholeCamera> cameras() {
+  return {dot_grid_test::oblique_camera(20, 5, 1, 14, 300, kWidth, kHeight),
+          dot_grid_test::oblique_camera(-20, -5, -2, 14, 300, kWidth, kHeight)};
+}
+
+class CalibrateImagesCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!tomorig_built()) GTEST_SKIP() << "tomorig binary not built";
+  }
+  // DIR/cam<c>/<z>mm_cam<c>.png for every camera and plane.
+  fs::path render_folder(const std::string& name, const std::vector<double>& planes, const TargetDrawing& target = {},
+                         int width = kWidth) {
+    const fs::path root = dir_ / name;
+    const auto cams = cameras();
+    for (std::size_t c = 0; c < cams.size(); ++c) {
+      fs::create_directories(root / fmt::format("cam{}", c));
+      for (const double z : planes)
+        storage::write_png(root / fmt::format("cam{}", c) / fmt::format("{}mm_cam{}.png", z, c),
+                           dot_grid_test::render_target(cams[c], target, z, width, kHeight, 8, 7 + c));
+    }
+    return root;
+  }
+  TempDir dir_;
+};
+
+TEST_F(CalibrateImagesCli, FolderOfDotImagesCalibratesToTheTrueCameras) {
+  const fs::path images = render_folder("calibration", kPlanes);
+  const std::string out = (dir_ / "calib.toml").string(), points = (dir_ / "points.csv").string();
+  const CliResult r = run_tomorig("calibrate --images " + shell_quoted(images.string()) +
+                                  " --spacing 2 --models pinhole,soloff3 --store pinhole --json --points-out " +
+                                  shell_quoted(points) + " -o " + shell_quoted(out));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["results"].size(), 4u);  // 2 cameras x 2 models
+  for (const nlohmann::json& result : j["results"]) {
+    EXPECT_EQ(result["planes"], 4);
+    EXPECT_GT(result["points"].get<int>(), 4 * 60) << result.dump();
+    EXPECT_LT(result["forward_px"].get<double>(), 0.1) << result.dump();
+    ASSERT_EQ(result["per_plane"].size(), 4u);
+    EXPECT_EQ(result["per_plane"][0]["z_mm"], -3.0);
+    for (const nlohmann::json& plane : result["per_plane"]) EXPECT_LT(plane["forward_px"].get<double>(), 0.1);
+  }
+  const auto loaded = calibration::load_calibration(out);
+  ASSERT_EQ(loaded.size(), 2u);
+  const auto truth = cameras();
+  for (std::size_t c = 0; c < 2; ++c) {
+    EXPECT_EQ(loaded[c].image_size.width, kWidth);
+    EXPECT_EQ(loaded[c].image_size.height, kHeight);
+    for (const Vec3d world : {Vec3d{1.3, -2.7, 0.4}, Vec3d{-4.1, 3.5, -2.2}, Vec3d{5.2, 4.9, 2.6}}) {
+      const Vec2d a = truth[c].project(world), b = loaded[c].model->project(world);
+      EXPECT_LT(std::hypot(a.x - b.x, a.y - b.y), 0.1) << "camera " << c;
+    }
+  }
+  EXPECT_TRUE(fs::exists(points));
+}
+
+TEST_F(CalibrateImagesCli, ImageListWithBlackDots) {
+  TargetDrawing target;
+  target.white_dots = false;
+  const fs::path images = render_folder("black", {-2, 2}, target);
+  std::ofstream(dir_ / "list.csv") << "camera,z,file\n"
+                                   << "0,-2,black/cam0/-2mm_cam0.png\n0,2,black/cam0/2mm_cam0.png\n"
+                                   << "1,-2,black/cam1/-2mm_cam1.png\n1,2,black/cam1/2mm_cam1.png\n";
+  const CliResult r = run_tomorig("calibrate --image-list " + shell_quoted((dir_ / "list.csv").string()) +
+                                  " --spacing 2 --dots black --models pinhole --json -o " +
+                                  shell_quoted((dir_ / "c.toml").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const nlohmann::json& result : nlohmann::json::parse(r.out)["results"])
+    EXPECT_LT(result["forward_px"].get<double>(), 0.1) << result.dump();
+}
+
+TEST_F(CalibrateImagesCli, BadInputNamesCameraAndPlane) {
+  const fs::path good = render_folder("good", kPlanes);
+  const std::string out = (dir_ / "x.toml").string();
+  auto run = [&](const std::string& images, const std::string& extra) {
+    return run_tomorig("calibrate --images " + shell_quoted(images) + " " + extra + " -o " + shell_quoted(out));
+  };
+  struct Case {
+    std::string name, images, args;
+    int exit_code;
+    std::vector<std::string> needles;
+  };
+  // Camera 1 has one image of another size.
+  const fs::path mixed = render_folder("mixed", kPlanes);
+  storage::write_png(mixed / "cam1" / "1mm_cam1.png",
+                     dot_grid_test::render_target(cameras()[1], {}, 1, kWidth + 16, kHeight));
+  // Camera 0 on one plane only.
+  const fs::path flat = render_folder("flat", {0});
+  // No origin marker.
+  TargetDrawing unmarked;
+  unmarked.marker_line_mm = 0;
+  const fs::path no_marker = render_folder("nomarker", {-1, 1}, unmarked);
+  // A file whose name holds no z.
+  const fs::path unnamed = render_folder("unnamed", {-1, 1});
+  fs::copy_file(unnamed / "cam0" / "1mm_cam0.png", unnamed / "cam0" / "target.png");
+
+  const std::vector<Case> cases = {
+      {"sizes", mixed.string(), "--spacing 2 --models pinhole", 2, {"camera 1, plane z = 1 mm", "same size"}},
+      {"flat", flat.string(), "--spacing 2 --models pinhole", 2, {"camera 0", "one plane (z = 0"}},
+      {"few", good.string(), "--spacing 2 --models pinhole --min-points-per-plane 1000", 2,
+       {"camera 0, plane z = -3 mm", "too few target points"}},
+      {"marker", no_marker.string(), "--spacing 2 --models pinhole", 2, {"camera 0, plane z = -1 mm", "origin marker"}},
+      {"name", unnamed.string(), "--spacing 2 --models pinhole", 2, {"target.png", "<z>mm"}},
+      {"spacing", good.string(), "--models pinhole", 2, {"--spacing"}},
+      {"polarity", good.string(), "--spacing 2 --dots grey", 2, {"--dots 'grey'"}},
+      {"converge", good.string(), "--spacing 2 --models rational2 --max-iterations 1", 1,
+       {"camera 0", "did not converge", "--max-iterations"}},
+  };
+  for (const Case& c : cases) {
+    const CliResult r = run(c.images, c.args);
+    EXPECT_EQ(r.exit_code, c.exit_code) << c.name << "\n" << r.err;
+    for (const std::string& needle : c.needles) EXPECT_NE(r.err.find(needle), std::string::npos) << c.name << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(out)) << c.name;
+  }
+  // Two sources at once.
+  const CliResult both = run_tomorig("calibrate --images " + shell_quoted(good.string()) + " --points p.csv --spacing 2 -o " +
+                                     shell_quoted(out));
+  EXPECT_EQ(both.exit_code, 2);
+  EXPECT_NE(both.err.find("exactly one of"), std::string::npos) << both.err;
+}
+
+}  // namespace
+}  // namespace tomorig::testing

@@ -1,0 +1,258 @@
+// `tomorig process` and `tomorig piv3d` end to end on a small simulated session (tpiv-thesis
+// rendered at full size, reconstructed on a sub-grid at the centre to keep the test quick):
+// the mean field against the analytic flow (thesis Eq. 3.13), interruption and resume, a write
+// failure, and every bad input of issue 5.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "child_process.h"
+#include "cli_runner.h"
+#include "tomorig/storage/results_file.h"
+#include "tomorig/storage/session_file.h"
+
+namespace tomorig::testing {
+namespace {
+namespace fs = std::filesystem;
+
+constexpr int kSets = 4;
+// Full depth (160 voxels, so no particle lies in front of or behind the grid), 96 x 96 in x, y.
+const std::string kGrid = "--grid 96,96,160,0.0195";
+const std::string kCorrelation = "--window 32,32,32 --overlap 0.5 --deformation-passes 1";
+
+class ProcessCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    if (!tomorig_built()) return;
+    dir_ = std::make_unique<TempDir>();
+    session_ = (*dir_ / "s.h5").string();
+    const CliResult r = run_tomorig("simulate --sets " + std::to_string(kSets) + " --ppp 0.05 --seed 11 -o " +
+                                    shell_quoted(session_));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  static void TearDownTestSuite() { dir_.reset(); }
+  void SetUp() override {
+    if (!tomorig_built()) GTEST_SKIP() << "tomorig binary not built";
+  }
+  static std::string base_args(const std::string& session, const fs::path& out) {
+    return "process --session " + shell_quoted(session) + " --calib truth " + kGrid + " -o " + shell_quoted(out.string());
+  }
+  static std::string process_args(const std::string& session, const fs::path& out) {
+    return base_args(session, out) + " " + kCorrelation;
+  }
+  static std::unique_ptr<TempDir> dir_;
+  static std::string session_;
+};
+std::unique_ptr<TempDir> ProcessCli::dir_;
+std::string ProcessCli::session_;
+
+// Eq. 3.13 with the parameters the simulator recorded in the session's truth.
+Vec3d analytic_voxel(const nlohmann::json& p, const Vec3d& world_mm) {
+  const double a = p["A_voxel"].get<double>(), period = p["p_voxel"].get<double>();
+  const double h = p["voxel_size_mm"].get<double>();
+  const double x = (world_mm.x - p["grid_origin_mm"][0].get<double>()) / h;
+  const double z = (world_mm.z - p["grid_origin_mm"][2].get<double>()) / h;
+  const double k = 2.0 * M_PI / period;
+  return {a * std::sin(k * x) * std::cos(k * z), -a * std::sin(k * x) * std::sin(k * z),
+          -a * std::cos(k * x) * std::sin(k * z)};
+}
+
+TEST_F(ProcessCli, MeanFieldMatchesTheAnalyticFlow) {
+  const fs::path out = *dir_ / "mean.h5";
+  const CliResult r = run_tomorig(process_args(session_, out) + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json summary = nlohmann::json::parse(r.out);
+  EXPECT_EQ(summary["sets_in_file"], kSets);
+  EXPECT_NE(r.err.find("sets/s"), std::string::npos) << r.err;  // the progress line
+  EXPECT_TRUE(fs::exists(*dir_ / "mean.xdmf"));
+
+  const storage::ResultsReader results(out);
+  ASSERT_EQ(results.set_indices().size(), static_cast<std::size_t>(kSets));
+  EXPECT_GT(results.read_set(0).dt_ns, 0);
+  const nlohmann::json params = nlohmann::json::parse(results.info().parameters_json);
+  EXPECT_EQ(params["reconstruction"]["algorithm"], "fmart");
+  const storage::EnsembleStatistics s = results.statistics();
+  const nlohmann::json flow = nlohmann::json::parse(storage::SessionReader(session_).truth().flow_parameters);
+  double sum2 = 0.0;
+  std::size_t n = 0, counted = 0;
+  for (int k = 1; k + 1 < s.nz; ++k)
+    for (int j = 1; j + 1 < s.ny; ++j)
+      for (int i = 1; i + 1 < s.nx; ++i) {
+        const std::size_t node = static_cast<std::size_t>(i) + s.nx * (j + static_cast<std::size_t>(s.ny) * k);
+        ++n;
+        if (s.valid_count[node] == 0) continue;
+        ++counted;
+        const Vec3d x{s.origin.x + i * s.spacing.x, s.origin.y + j * s.spacing.y, s.origin.z + k * s.spacing.z};
+        const Vec3d e = s.mean_displacement_voxel[node] - analytic_voxel(flow, x);
+        sum2 += e.x * e.x + e.y * e.y + e.z * e.z;
+      }
+  ASSERT_GT(n, 0u);
+  EXPECT_GT(static_cast<double>(counted) / n, 0.9);
+  const double rms = std::sqrt(sum2 / std::max<std::size_t>(counted, 1));
+  std::printf("[ figures ] process mean field over %d sets: RMS %.3f voxel at %zu interior nodes\n", kSets, rms, n);
+  EXPECT_LT(rms, 0.35);  // the flow's amplitude is 5 voxel
+}
+
+TEST_F(ProcessCli, InterruptedAndKilledRunsResumeWithoutRecomputing) {
+  const fs::path out = *dir_ / "resume.h5";
+  const auto args = [&] {
+    return std::vector<std::string>{"process", "--session", session_, "--calib", "truth", "--grid", "96,96,160,0.0195",
+                                    "--window", "32,32,32", "--overlap", "0.5", "--deformation-passes", "1",
+                                    "-o", out.string()};
+  };
+  {  // Ctrl-C after the first set: a valid file, exit 1, a message saying how to resume
+    TomorigProcess p(args());
+    ASSERT_TRUE(p.wait_for_line("set 0 done"));
+    p.send_signal(SIGINT);
+    EXPECT_EQ(p.wait(), 1) << p.err();
+    EXPECT_NE(p.err().find("run the same command again to resume"), std::string::npos) << p.err();
+  }
+  const auto first = storage::ResultsReader(out).set_indices();
+  ASSERT_GE(first.size(), 1u);
+  ASSERT_LT(first.size(), static_cast<std::size_t>(kSets));
+  const std::string stamp0 = storage::ResultsReader(out).read_set(0).completed_utc;
+  {  // SIGKILL after one more set: no chance to clean up, the file must still be valid
+    TomorigProcess p(args());
+    ASSERT_TRUE(p.wait_for_line("resuming"));
+    ASSERT_TRUE(p.wait_for_line("done"));
+    p.send_signal(SIGKILL);
+    p.wait();
+  }
+  const auto second = storage::ResultsReader(out).set_indices();
+  EXPECT_GT(second.size(), first.size());
+  EXPECT_EQ(storage::ResultsReader(out).read_set(0).completed_utc, stamp0);
+  std::vector<std::string> stamps;
+  for (const auto i : second) stamps.push_back(storage::ResultsReader(out).read_set(i).completed_utc);
+
+  TomorigProcess last(args());
+  EXPECT_EQ(last.wait(), 0) << last.err();
+  EXPECT_NE(last.err().find(std::to_string(second.size()) + " sets already finished"), std::string::npos) << last.err();
+  for (const auto i : second)  // finished sets were not processed again
+    EXPECT_EQ(last.err().find("set " + std::to_string(i) + " done"), std::string::npos) << last.err();
+  const storage::ResultsReader done(out);
+  EXPECT_EQ(done.set_indices().size(), static_cast<std::size_t>(kSets));
+  for (std::size_t n = 0; n < second.size(); ++n) EXPECT_EQ(done.read_set(second[n]).completed_utc, stamps[n]);
+}
+
+TEST_F(ProcessCli, WriteFailureMidRunKeepsTheFinishedSets) {
+  // A full disk as the writer sees it: the file-size limit of the shell (512-byte blocks),
+  // SIGXFSZ ignored so that write() fails instead of killing the process. The limit (66 KB) leaves
+  // room for a file of one or two sets (50 KB with one, ~12 KB more per set) but not four.
+  const fs::path out = *dir_ / "full.h5";
+  const std::string cmd = "ulimit -f 130; trap '' XFSZ; exec " + shell_quoted(TOMORIG_BINARY) + " " +
+                          process_args(session_, out) + " --sequential >/dev/null 2>" +
+                          shell_quoted((*dir_ / "full.err").string());
+  const int status = std::system(("sh -c " + shell_quoted(cmd)).c_str());
+  const std::string err = read_text_file(*dir_ / "full.err");
+  ASSERT_TRUE(WIFEXITED(status)) << err;
+  EXPECT_EQ(WEXITSTATUS(status), 1) << err;
+  EXPECT_NE(err.find("is the disk full?"), std::string::npos) << err;
+  const storage::ResultsReader results(out);  // still a valid results file
+  EXPECT_LT(results.set_indices().size(), static_cast<std::size_t>(kSets));
+  EXPECT_GE(results.set_indices().size(), 1u);
+  // The sets it holds are complete, and a run with space finishes the rest.
+  for (const auto i : results.set_indices()) EXPECT_EQ(results.read_set(i).field.count(), results.read_set(0).field.count());
+  const CliResult again = run_tomorig(process_args(session_, out));
+  EXPECT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(storage::ResultsReader(out).set_indices().size(), static_cast<std::size_t>(kSets));
+}
+
+// A copy of the session whose sets record no pulse separation.
+std::string session_without_dt(const std::string& source, const fs::path& out) {
+  const storage::SessionReader in(source);
+  storage::SessionInfo info = in.info();
+  // Another recording: a creation time of its own, even when the copy is made within the same
+  // second as the source (the session identity includes it).
+  info.created_utc = "2001-02-03T04:05:06Z";
+  storage::SessionWriter w(out, info);
+  w.write_truth(in.truth());
+  FrameSet set = in.read_set(0);
+  set.dt_ns = 0;
+  w.append(set);
+  w.write_truth_set(0, in.truth_set(0));
+  w.finish();
+  return out.string();
+}
+
+TEST_F(ProcessCli, BadInputIsExitCode2WithAReason) {
+  const fs::path out = *dir_ / "bad.h5";
+  const std::string no_dt = session_without_dt(session_, *dir_ / "no_dt.h5");
+  struct Case {
+    std::string args, needle;
+  };
+  for (const Case& c : {
+           Case{process_args(no_dt, out), "--dt-ns"},
+           Case{process_args(session_, out) + " --dt-ns -3", "--dt-ns -3 must be > 0"},
+           Case{base_args(session_, out) + " --window 128,32,32", "larger than the volume"},
+           Case{base_args(session_, out) + " --window 12,x", "--window '12,x' is not valid"},
+           Case{process_args(session_, out) + " --algorithm nope", "nope"},
+           Case{"process --session nope.h5 -o " + shell_quoted(out.string()), "does not exist"},
+       }) {
+    const CliResult r = run_tomorig(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.needle), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(out)) << c.args;
+  }
+}
+
+TEST_F(ProcessCli, RefusesResultsOfAnotherSessionOrGrid) {
+  // A results file of one set of the dt-less copy (dt given on the command line)...
+  const std::string other = session_without_dt(session_, *dir_ / "other.h5");
+  const fs::path out = *dir_ / "other_results.h5";
+  const CliResult made = run_tomorig(process_args(other, out) + " --dt-ns 100000");
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  // ...is not resumed by a run on another session,
+  const CliResult wrong_session = run_tomorig(process_args(session_, out));
+  EXPECT_EQ(wrong_session.exit_code, 2) << wrong_session.err;
+  EXPECT_NE(wrong_session.err.find("belongs to another session"), std::string::npos) << wrong_session.err;
+  // nor by a run of the same session on another grid,
+  std::string args = process_args(other, out) + " --dt-ns 100000";
+  args.replace(args.find("96,96,160"), 9, "64,64,160");
+  const CliResult wrong_grid = run_tomorig(args);
+  EXPECT_EQ(wrong_grid.exit_code, 2) << wrong_grid.err;
+  EXPECT_NE(wrong_grid.err.find("another reconstruction grid"), std::string::npos) << wrong_grid.err;
+  EXPECT_EQ(storage::ResultsReader(out).set_indices().size(), 1u);  // untouched
+}
+
+TEST_F(ProcessCli, Piv3dCorrelatesTheVolumesOfReconstruct) {
+  const fs::path volumes = *dir_ / "v.h5";
+  const CliResult rec = run_tomorig("reconstruct --session " + shell_quoted(session_) + " --calib truth " + kGrid +
+                                    " --sparse-only -o " + shell_quoted(volumes.string()));
+  ASSERT_EQ(rec.exit_code, 0) << rec.err;
+  const fs::path out = *dir_ / "piv3d.h5";
+  const CliResult r = run_tomorig("piv3d --volumes " + shell_quoted(volumes.string()) + " " + kCorrelation +
+                                  " --json -o " + shell_quoted(out.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const storage::ResultsReader results(out);
+  ASSERT_EQ(results.set_indices().size(), 1u);
+  const storage::SetResult set = results.read_set(0);
+  EXPECT_EQ(set.dt_ns, storage::SessionReader(session_).set_record(0).dt_ns);
+  std::size_t valid = 0;
+  for (const VectorStatus st : set.field.status) valid += st == VectorStatus::valid;
+  EXPECT_GT(static_cast<double>(valid) / set.field.count(), 0.6);  // 5 x 5 x 9 nodes, most on a face
+
+  const CliResult too_big = run_tomorig("piv3d --volumes " + shell_quoted(volumes.string()) +
+                                        " --window 256,32,32 -o " + shell_quoted((*dir_ / "x.h5").string()));
+  EXPECT_EQ(too_big.exit_code, 2) << too_big.err;
+  EXPECT_NE(too_big.err.find("larger than the volume"), std::string::npos) << too_big.err;
+
+  const fs::path smaller = *dir_ / "v64.h5";
+  ASSERT_EQ(run_tomorig("reconstruct --session " + shell_quoted(session_) +
+                        " --calib truth --grid 64,64,160,0.0195 --exposure b --sparse-only -o " +
+                        shell_quoted(smaller.string()))
+                .exit_code,
+            0);
+  const CliResult grids = run_tomorig("piv3d --volumes " + shell_quoted(volumes.string()) + " --volume-b " +
+                                      shell_quoted(smaller.string()) + " -o " + shell_quoted((*dir_ / "y.h5").string()));
+  EXPECT_EQ(grids.exit_code, 2) << grids.err;
+  EXPECT_NE(grids.err.find("different grids"), std::string::npos) << grids.err;
+}
+
+}  // namespace
+}  // namespace tomorig::testing
