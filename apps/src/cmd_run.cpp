@@ -63,15 +63,6 @@ std::filesystem::path default_output_path() {
   return std::filesystem::path("runs") / fmt::format("session-{}.h5", stamp);
 }
 
-std::string utc_now_iso8601() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char text[32];
-  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return text;
-}
-
 trigger::Pacing parse_pace(const std::string& text) {
   if (text == "real-time") return trigger::Pacing::real_time;
   if (text == "max") return trigger::Pacing::as_fast_as_consumed;
@@ -172,7 +163,6 @@ void run(const RunOptions& opt) {
   info.cameras = rig_run.session_cameras();
   info.rig_config_toml = rig.source_text;
   info.software_version = std::string(software_version());
-  info.created_utc = utc_now_iso8601();
   storage::SessionWriterOptions writer_options;
   writer_options.live = true;
   writer_options.compression = *compression;

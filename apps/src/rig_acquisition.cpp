@@ -21,18 +21,6 @@ using Clock = std::chrono::steady_clock;
 // How often the loop looks up from waiting for an event to check for a stop or the duration.
 constexpr std::chrono::milliseconds kEventPoll{50};
 
-storage::TruthCamera truth_camera_of(const sim::SimulatedCamera& cam) {
-  storage::TruthCamera t;
-  t.id = cam.spec.id;
-  t.model = cam.model.model_name();
-  t.K = cam.model.intrinsics();
-  t.R = cam.model.parameters().R;
-  t.t = cam.model.parameters().t;
-  t.width = cam.spec.width;
-  t.height = cam.spec.height;
-  return t;
-}
-
 }  // namespace
 
 std::optional<CameraLossPolicy> parse_camera_loss_policy(std::string_view text) {

@@ -12,19 +12,6 @@
 
 namespace tomorig::app {
 
-namespace {
-
-std::string utc_now() {
-  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char text[32];
-  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return text;
-}
-
-}  // namespace
-
 std::string calib_target_truth_json(const sim::CalibTargetCase& c) {
   nlohmann::json planes = nlohmann::json::array();
   for (std::size_t k = 0; k < c.planes.size(); ++k) {
@@ -63,7 +50,6 @@ std::string write_calib_target_session(const sim::CalibTargetOptions& options, c
       "# traverse; set k shows plane k (z_nominal_mm in /truth, flow_parameters). No rig config applies.\n",
       c.board.inner_corners_x, c.board.inner_corners_y, c.board.square_mm);
   info.software_version = std::string(software_version());
-  info.created_utc = utc_now();
   info.compression = compression;
   storage::SessionWriterOptions wo;
   wo.compression = compression;

@@ -20,22 +20,15 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-std::string utc_now_iso8601() {
-  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char text[32];
-  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return text;
-}
-
 std::string human_bytes(std::uintmax_t bytes) {
   if (bytes >= 1024 * 1024) return fmt::format("{:.1f} MiB", bytes / (1024.0 * 1024.0));
   if (bytes >= 1024) return fmt::format("{:.1f} KiB", bytes / 1024.0);
   return fmt::format("{} B", bytes);
 }
 
-storage::TruthCamera truth_camera(const sim::SimulatedCamera& cam) {
+}  // namespace
+
+storage::TruthCamera truth_camera_of(const sim::SimulatedCamera& cam) {
   storage::TruthCamera t;
   t.id = cam.spec.id;
   t.model = cam.model.model_name();
@@ -46,8 +39,6 @@ storage::TruthCamera truth_camera(const sim::SimulatedCamera& cam) {
   t.height = cam.spec.height;
   return t;
 }
-
-}  // namespace
 
 std::string SimulationSummary::brief() const {
   return fmt::format("wrote {}: {}, {} set{} x {} cameras, {} particles per set, {} in {:.2f} s", output.string(),
@@ -126,7 +117,6 @@ SimulationSummary run_simulation_to_session(const config::RigConfig& rig, const 
                             cam.spec.pixel_pitch_um});
   info.rig_config_toml = rig.source_text;
   info.software_version = std::string(software_version());
-  info.created_utc = utc_now_iso8601();
   info.compression = compression;
 
   storage::SessionWriterOptions writer_options;
@@ -141,7 +131,7 @@ SimulationSummary run_simulation_to_session(const config::RigConfig& rig, const 
   truth.flow_parameters = simulated.flow().parameters_json();
   truth.seed = options.seed;
   truth.ppp = options.ppp;
-  for (const sim::SimulatedCamera& cam : simulated.cameras()) truth.cameras.push_back(truth_camera(cam));
+  for (const sim::SimulatedCamera& cam : simulated.cameras()) truth.cameras.push_back(truth_camera_of(cam));
   writer.write_truth(truth);
 
   // Render set k + 1 while set k is written: the two take similar time on tpiv-thesis, and

@@ -30,6 +30,9 @@ struct SimulationSummary {
 // the previous set was written (rendering overlaps writing, so this is the cost per set).
 using SimulationProgress = std::function<void(std::uint64_t done, std::uint64_t total, double set_seconds)>;
 
+// The truth record of a simulated camera (its exact pinhole model and image size).
+storage::TruthCamera truth_camera_of(const sim::SimulatedCamera& cam);
+
 // The simulator options a rig config describes: its [simulation] section, its cameras (all
 // must use the simulated backend, their pixel formats must match simulation.bit_depth) and
 // its trigger rate and pulse separation. Throws tomorig::Error (bad_input) naming the key.
