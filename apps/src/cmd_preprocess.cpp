@@ -16,6 +16,7 @@
 #include <fmt/core.h>
 
 #include "commands.h"
+#include "process_preprocess.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/preprocess/chain_spec.h"
 #include "tomorig/processing/preprocess/image_chain.h"
@@ -59,33 +60,6 @@ SetRange parse_sets(const std::string& text, std::uint64_t count) {
   if (range.end > count) fail("the end is past the last set");
   if (range.first >= range.end) fail("the range is empty");
   return range;
-}
-
-// The average of every present frame of `camera_id` in a session of reference frames (darks or
-// bright fields).
-Image reference_image(const fs::path& file, const std::string& camera_id, std::size_t step) {
-  const auto reader = [&] {
-    try {
-      return std::make_unique<storage::SessionReader>(file);
-    } catch (const Error& e) {
-      throw Error(e.kind(), fmt::format("preprocess step {}: reference frames: {}", step, e.what()));
-    }
-  };
-  const std::unique_ptr<storage::SessionReader> opened = reader();
-  const storage::SessionReader& reference = *opened;
-  preprocess::MeanImage mean;
-  for (std::uint64_t s = 0; s < reference.set_count(); ++s) {
-    const FrameSet set = reference.read_set(s);
-    for (const CameraFrames& c : set.cameras) {
-      if (c.camera_id != camera_id) continue;
-      for (const Frame* f : {&c.a, &c.b})
-        if (f->present()) mean.add(f->image);
-    }
-  }
-  if (mean.count() == 0)
-    throw bad_input(fmt::format("preprocess step {}: reference session '{}' has no frame of camera '{}'", step,
-                                file.string(), camera_id));
-  return mean.result();
 }
 
 // A relative reference path in the chain file is relative to the chain file's folder.

@@ -1,6 +1,7 @@
 #include "process_preprocess.h"
 
 #include <array>
+#include <memory>
 
 #include <fmt/core.h>
 
@@ -11,26 +12,30 @@
 namespace tomorig::app {
 namespace fs = std::filesystem;
 
-namespace {
-
-// The average of every present frame of `camera_id` in a session of reference frames.
 Image reference_image(const fs::path& file, const std::string& camera_id, std::size_t step) {
-  const storage::SessionReader reference(file);
+  const auto reader = [&] {
+    try {
+      return std::make_unique<storage::SessionReader>(file);
+    } catch (const Error& e) {
+      throw Error(e.kind(), fmt::format("preprocess step {}: reference frames: {}", step, e.what()));
+    }
+  };
+  const std::unique_ptr<storage::SessionReader> opened = reader();
+  const storage::SessionReader& reference = *opened;
   preprocess::MeanImage mean;
   for (std::uint64_t s = 0; s < reference.set_count(); ++s) {
     const FrameSet set = reference.read_set(s);
-    for (const CameraFrames& c : set.cameras)
-      if (c.camera_id == camera_id)
-        for (const Frame* f : {&c.a, &c.b})
-          if (f->present()) mean.add(f->image);
+    for (const CameraFrames& c : set.cameras) {
+      if (c.camera_id != camera_id) continue;
+      for (const Frame* f : {&c.a, &c.b})
+        if (f->present()) mean.add(f->image);
+    }
   }
   if (mean.count() == 0)
     throw bad_input(fmt::format("preprocess step {}: reference session '{}' has no frame of camera '{}'", step,
                                 file.string(), camera_id));
   return mean.result();
 }
-
-}  // namespace
 
 SessionPreprocessor::SessionPreprocessor(const storage::SessionReader& session, const fs::path& chain_file) {
   if (chain_file.empty()) return;

@@ -3,7 +3,9 @@
 // `tomorig preprocess --chain`, docs/preprocessing.md) run on every frame of a set, one chain
 // per camera. Sequence statistics (subtract_minimum, normalize by average_image) are computed
 // in streaming passes over the whole session when the preprocessor is made.
+#include <cstddef>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "tomorig/core/frame_set.h"
@@ -11,6 +13,11 @@
 #include "tomorig/storage/session_file.h"
 
 namespace tomorig::app {
+
+// The average of every present frame of `camera_id` in a session of reference frames (darks or
+// bright fields), for chain step `step`. Throws tomorig::Error naming the step when the file
+// cannot be read or holds no frame of that camera.
+Image reference_image(const std::filesystem::path& file, const std::string& camera_id, std::size_t step);
 
 class SessionPreprocessor {
  public:
