@@ -21,7 +21,7 @@ endfunction()
 function(tomorig_add_test module)
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
   add_executable(test_${module} ${ARG_SOURCES})
-  target_link_libraries(test_${module} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
+  target_link_libraries(test_${module} PRIVATE ${ARG_DEPS} tomorig::large_pages GTest::gtest GTest::gtest_main)
   target_compile_definitions(test_${module} PRIVATE
       TOMORIG_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
       TOMORIG_SHARED_DIR="${PROJECT_SOURCE_DIR}/../shared"

@@ -38,6 +38,7 @@ struct BenchReconArgs {
   int iterations = 0;
   double relaxation = 1.0;
   double mlos_threshold = 0.05;
+  double prune_fraction = -1.0;  // < 0: the library default
   std::string grid;
   std::uint64_t seed = 1;
   int threads = 0;
@@ -51,6 +52,10 @@ struct BenchReconArgs {
   int exposures = 0;  // 1: A only, 2: A and B (a double exposure); 0: the case's default
   double max_truth_mb = 1024.0;
 };
+
+double base_prune_fraction(const BenchReconArgs& args) {
+  return args.prune_fraction >= 0 ? args.prune_fraction : recon::ReconstructionOptions{}.prune_fraction;
+}
 
 // A double exposure for the speed-and-memory case (the thesis timed two volumes), one exposure
 // otherwise.
@@ -164,6 +169,7 @@ void run(const BenchReconArgs& args) {
   recon::ReconstructionOptions base;
   base.relaxation = args.relaxation;
   base.mlos_threshold = args.mlos_threshold;
+  if (args.prune_fraction >= 0) base.prune_fraction = args.prune_fraction;
   base.threads = args.threads;
   if (args.iterations > 0) base.max_iterations = args.iterations;
   for (const std::string& a : args.algorithms) {  // refuse a typo before minutes of work
@@ -279,6 +285,7 @@ void run(const BenchReconArgs& args) {
                               {"grid", {case_grid.nx, case_grid.ny, case_grid.nz}},
                               {"exposure", exposures == 1 ? "A" : "A+B"},
                               {"mlos_threshold", args.mlos_threshold},
+                              {"prune_fraction", base_prune_fraction(args)},
                               {"seed", args.seed},
                               {"machine", machine_json()},
                               {"results", results},
@@ -299,6 +306,10 @@ void add_bench_recon_command(CLI::App& bench) {
   cmd->add_option("--iterations", args->iterations, "Iterations of the iterative algorithms (0: their default)");
   cmd->add_option("--relaxation", args->relaxation, "Relaxation mu in (0, 2]")->capture_default_str();
   cmd->add_option("--mlos-threshold", args->mlos_threshold, "MLOS empty-pixel fraction of the image maximum")
+      ->capture_default_str();
+  cmd->add_option("--prune", args->prune_fraction,
+                  "SMART/FMART: drop voxels below this fraction of the largest intensity after each iteration "
+                  "(0: never; negative: the library default)")
       ->capture_default_str();
   cmd->add_option("--grid", args->grid, "Override the case's grid: nx,ny,nz,voxel_mm[,cx,cy,cz]");
   cmd->add_option("--seed", args->seed, "Random seed of the particle field")->capture_default_str();

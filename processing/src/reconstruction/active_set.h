@@ -1,6 +1,8 @@
 #pragma once
 // The sparse support of a reconstruction: active voxels in ascending linear index, an initial
-// intensity each, and (optionally) their image position in every camera, as produced by MLOS.
+// intensity each, as produced by MLOS. Image positions are not kept: the sparse system
+// recomputes them from the GridProjector, which costs less than storing 8 bytes per voxel and
+// camera, copying them once more when the slices are joined, and reading them back.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -10,7 +12,6 @@ namespace tomorig::recon::detail {
 struct ActiveSet {
   std::vector<std::uint32_t> index;
   std::vector<float> value;
-  std::vector<std::vector<float>> u, v;  // [camera][voxel]; empty when positions were not kept
 
   std::size_t size() const { return index.size(); }
 };

@@ -64,7 +64,7 @@ class MartReconstructor final : public Reconstructor {
     const int p = options_.patch_size > 0 ? options_.patch_size : 4;
     needs.extra_bytes_per_voxel = static_cast<double>(input.cameras.size()) * p * p * 8.0;
     Support s = build_support(input, options_, needs, report);
-    SparseSystem system(s.in, s.set, s.patch, options_.lut_steps);
+    SparseSystem system(s.in, s.set.index, *s.projector, s.patch, options_.lut_steps);
     std::vector<RayTable> rays;
     for (std::size_t c = 0; c < system.cameras(); ++c) rays.push_back(rays_of(system, c));
     std::vector<float> e(system.voxels(), 1.0f);

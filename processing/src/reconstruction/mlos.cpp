@@ -77,7 +77,6 @@ struct SampledImage {
 struct SliceResult {
   std::vector<std::uint32_t> index;
   std::vector<float> value;
-  std::vector<std::vector<float>> u, v;
 };
 
 }  // namespace
@@ -115,10 +114,6 @@ ActiveSet run_mlos(const PreparedInput& in, const GridProjector& projector, cons
     for (int k = 0; k < g.nz; ++k) {
       if (over_budget.load(std::memory_order_relaxed)) continue;
       SliceResult& out = slices[static_cast<std::size_t>(k)];
-      if (settings.keep_positions) {
-        out.u.resize(cams);
-        out.v.resize(cams);
-      }
       for (int j = 0; j < g.ny; ++j) {
         // First camera: the whole row's positions (a linear fill), one byte of the reach mask
         // per voxel, and the bilinear sample only where it can be non-zero. Later cameras:
@@ -164,11 +159,6 @@ ActiveSet run_mlos(const PreparedInput& in, const GridProjector& projector, cons
           const int i = alive[n];
           out.index.push_back(static_cast<std::uint32_t>(g.linear(i, j, k)));
           out.value.push_back(product[i]);
-          if (settings.keep_positions)
-            for (std::size_t c = 0; c < cams; ++c) {
-              out.u[c].push_back(u[c * g.nx + i]);
-              out.v[c].push_back(v[c * g.nx + i]);
-            }
         }
       }
       const std::size_t total = active.fetch_add(out.index.size()) + out.index.size();
@@ -189,21 +179,12 @@ ActiveSet run_mlos(const PreparedInput& in, const GridProjector& projector, cons
   const std::size_t total = first.back();
   set.index.resize(total);
   set.value.resize(total);
-  if (settings.keep_positions) {
-    set.u.assign(cams, std::vector<float>(total));
-    set.v.assign(cams, std::vector<float>(total));
-  }
 #pragma omp parallel for num_threads(in.threads) schedule(dynamic, 4)
   for (int k = 0; k < g.nz; ++k) {
     SliceResult& s = slices[static_cast<std::size_t>(k)];
     const std::size_t at = first[static_cast<std::size_t>(k)];
     std::copy(s.index.begin(), s.index.end(), set.index.begin() + at);
     std::copy(s.value.begin(), s.value.end(), set.value.begin() + at);
-    if (settings.keep_positions)
-      for (std::size_t c = 0; c < cams; ++c) {
-        std::copy(s.u[c].begin(), s.u[c].end(), set.u[c].begin() + at);
-        std::copy(s.v[c].begin(), s.v[c].end(), set.v[c].begin() + at);
-      }
     s = {};
   }
   return set;

@@ -13,7 +13,6 @@ namespace tomorig::recon::detail {
 
 struct MlosSettings {
   double threshold = 0.05;      // fraction of each image's maximum below which a pixel is empty
-  bool keep_positions = false;  // also return every active voxel's (u, v) in every camera
   // Memory check while the support grows: refuse once fixed + per_voxel * active exceeds it.
   double fixed_bytes = 0.0;
   double bytes_per_voxel = 0.0;

@@ -120,6 +120,40 @@ void accumulate_kernel(const W& w, const std::int32_t* offset, const float* log_
     acc[n] += w.gather(static_cast<std::size_t>(n), log_ratio + offset[n], stride);
 }
 
+// Calls visit(n, u, v) with the image position in camera c of every voxel index[n]. Voxels of
+// one grid row come in runs (the index is ascending), so each run costs one row_at() call.
+template <class F>
+void for_each_position(const PreparedInput& in, const std::vector<std::uint32_t>& index, const GridProjector& projector,
+                       std::size_t c, F&& visit) {
+  const VoxelGrid& g = in.grid;
+  const std::uint32_t nx = static_cast<std::uint32_t>(g.nx);
+  constexpr std::size_t kBlock = 1 << 16;
+  const std::ptrdiff_t blocks = static_cast<std::ptrdiff_t>((index.size() + kBlock - 1) / kBlock);
+#pragma omp parallel num_threads(in.threads)
+  {
+    std::vector<float> u(static_cast<std::size_t>(g.nx)), v(static_cast<std::size_t>(g.nx));
+    std::vector<int> columns(static_cast<std::size_t>(g.nx));
+#pragma omp for schedule(static)
+    for (std::ptrdiff_t b = 0; b < blocks; ++b) {
+      const std::size_t end = std::min(index.size(), static_cast<std::size_t>(b + 1) * kBlock);
+      for (std::size_t first = static_cast<std::size_t>(b) * kBlock; first < end;) {
+        const std::uint32_t row = index[first] / nx;
+        std::size_t last = first;
+        int count = 0;
+        while (last < end && index[last] / nx == row) columns[count++] = static_cast<int>(index[last++] - row * nx);
+        projector.row_at(c, static_cast<int>(row % static_cast<std::uint32_t>(g.ny)),
+                         static_cast<int>(row / static_cast<std::uint32_t>(g.ny)), columns.data(), count, u.data(),
+                         v.data());
+        for (std::size_t n = first; n < last; ++n) {
+          const int i = columns[n - first];
+          visit(n, u[i], v[i]);
+        }
+        first = last;
+      }
+    }
+  }
+}
+
 }  // namespace
 
 template <class F>
@@ -139,8 +173,9 @@ void SparseSystem::with_weights(const Camera& cam, F&& kernel) const {
   }
 }
 
-SparseSystem::SparseSystem(const PreparedInput& in, const ActiveSet& set, int patch, int lut_steps)
-    : patch_(patch), voxels_(set.size()) {
+SparseSystem::SparseSystem(const PreparedInput& in, const std::vector<std::uint32_t>& index,
+                           const GridProjector& projector, int patch, int lut_steps)
+    : patch_(patch), voxels_(index.size()) {
   const VoxelGrid& g = in.grid;
   const std::size_t plane = static_cast<std::size_t>(g.nx) * g.ny;
   std::size_t largest_image = 0;
@@ -184,28 +219,24 @@ SparseSystem::SparseSystem(const PreparedInput& in, const ActiveSet& set, int pa
     }
 
     cam.offset.resize(voxels_);
-    const float* u = set.u[c].data();
-    const float* v = set.v[c].data();
-    const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(voxels_);
-#pragma omp parallel for num_threads(in.threads) schedule(static)
-    for (std::ptrdiff_t n = 0; n < count; ++n) {
-      const int k = static_cast<int>(set.index[n] / plane);
+    for_each_position(in, index, projector, c, [&](std::size_t n, float u, float v) {
+      const int k = static_cast<int>(index[n] / plane);
       int su = 0, sv = 0;
       if (cam.rotated) {
         std::uint16_t qu = 0, qv = 0;
-        cam.u_weights.locate(u[n], 0, su, qu);
-        cam.v_weights.locate(v[n], 0, sv, qv);
+        cam.u_weights.locate(u, 0, su, qu);
+        cam.v_weights.locate(v, 0, sv, qv);
         cam.row_2d[n] = cam.block_weights.row(k, qu, qv);
       } else {
-        cam.u_weights.locate(u[n], k, su, cam.row_u[n]);
-        cam.v_weights.locate(v[n], k, sv, cam.row_v[n]);
+        cam.u_weights.locate(u, k, su, cam.row_u[n]);
+        cam.v_weights.locate(v, k, sv, cam.row_v[n]);
       }
       // Active voxels image inside every camera, so this clamp never moves one; it only
       // guarantees that no patch can reach outside the padded image.
       su = std::clamp(su, -cam.pad, cam.width + cam.pad - patch);
       sv = std::clamp(sv, -cam.pad, cam.height + cam.pad - patch);
       cam.offset[n] = (sv + cam.pad) * cam.stride + su + cam.pad;
-    }
+    });
     cams_.push_back(std::move(cam));
   }
   scratch_.resize(static_cast<std::size_t>(std::max(0, in.threads - 1)), std::vector<float>(largest_image, 0.0f));
@@ -213,9 +244,9 @@ SparseSystem::SparseSystem(const PreparedInput& in, const ActiveSet& set, int pa
 
 double SparseSystem::estimate_bytes(const PreparedInput& in, std::size_t voxels, int patch, int threads) {
   const double cams = static_cast<double>(in.camera_count());
-  // index + intensity + SMART accumulator + MLOS value, and per camera: offset, two LUT rows
-  // and the float (u, v) MLOS hands over.
-  const double per_voxel = 16.0 + cams * (8.0 + 8.0);
+  // index + intensity + SMART accumulator + MLOS value, and per camera: offset and two LUT
+  // rows (or one 2-D row).
+  const double per_voxel = 16.0 + cams * 8.0;
   return per_voxel * static_cast<double>(voxels) + image_bytes(in, 3, patch + 1) +
          image_bytes(in, 1, patch + 1) / cams * std::max(0, threads - 1);
 }

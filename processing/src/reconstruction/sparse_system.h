@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "active_set.h"
+#include "grid_projector.h"
 #include "prepared_input.h"
 #include "weight_table.h"
 
@@ -21,8 +21,10 @@ struct PixelResidual {
 
 class SparseSystem {
  public:
-  // `set` must carry positions for every camera. patch: p; lut_steps: sub-pixel steps.
-  SparseSystem(const PreparedInput& in, const ActiveSet& set, int patch, int lut_steps);
+  // index: the active voxels (ascending linear index); their image positions come from the
+  // projector. patch: p; lut_steps: sub-pixel steps.
+  SparseSystem(const PreparedInput& in, const std::vector<std::uint32_t>& index, const GridProjector& projector,
+               int patch, int lut_steps);
 
   // Memory estimate of a system of `voxels` voxels (index, intensity, scratch and per camera
   // offset + 2 LUT rows) plus its images, for the up-front check.

@@ -63,11 +63,10 @@ Support build_support(const ReconstructionInput& input, const ReconstructionOpti
                              s.in.grid.nz, 100.0 * expected_fraction));
 
   timer.mark("memory estimate");
-  const GridProjector projector(s.in);
+  const GridProjector& projector = s.projector.emplace(s.in);
   timer.mark("grid projector");
   MlosSettings mlos;
   mlos.threshold = needs.mlos_threshold;
-  mlos.keep_positions = needs.positions;
   mlos.fixed_bytes = fixed;
   mlos.bytes_per_voxel = per_voxel;
   mlos.memory_limit_mb = options.memory_limit_mb;

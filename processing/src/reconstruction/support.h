@@ -3,6 +3,7 @@
 // projections, check memory up front, run MLOS. And the common last steps: the sparse volume
 // and the report's totals.
 #include <chrono>
+#include <optional>
 
 #include "active_set.h"
 #include "grid_projector.h"
@@ -14,6 +15,7 @@ namespace tomorig::recon::detail {
 struct Support {
   PreparedInput in;
   ActiveSet set;
+  std::optional<GridProjector> projector;  // image positions of the voxels, for the sparse system
   int patch = 3;  // p of the sparse system
 };
 
@@ -21,7 +23,7 @@ struct Support {
 // it needs the voxels' image positions.
 struct SupportNeeds {
   double mlos_threshold = 0.05;
-  bool positions = true;
+  bool positions = true;  // a sparse system will be built (for the memory checks)
   double extra_bytes_per_voxel = 0.0;  // beyond the sparse system's own
 };
 

@@ -71,7 +71,7 @@ struct ReconstructionOptions {
   // largest intensity are set to 0 and dropped from the voxel list, so later iterations only
   // visit the live ones (ghosts decay by orders of magnitude within 1-2 iterations). 0 keeps
   // every MLOS voxel to the end.
-  double prune_fraction = 0.0;
+  double prune_fraction = 1e-3;
   // OpenMP threads; 0: the OpenMP default. Results do not depend on it beyond rounding order.
   int threads = 0;
   // Memory the reconstruction may use, MB; 0: 80 % of MemAvailable from /proc/meminfo. The estimate is
