@@ -98,5 +98,24 @@ TEST(BenchReconCli, PrintsTheDocumentedJson) {
   EXPECT_LE(result["q_global"].get<double>(), 1.0);
 }
 
+TEST(BenchReconCli, RepeatReportsWarmRoundsOfTheSameReconstruction) {
+  const CliResult once = run_tomorig("bench recon --ppp 0.01 --algorithms fmart --iterations 2 --grid 96,96,24,0.0195");
+  const CliResult thrice =
+      run_tomorig("bench recon --ppp 0.01 --algorithms fmart --iterations 2 --repeat 3 --grid 96,96,24,0.0195");
+  ASSERT_EQ(once.exit_code, 0) << once.err;
+  ASSERT_EQ(thrice.exit_code, 0) << thrice.err;
+  const nlohmann::json a = nlohmann::json::parse(once.out)["results"][0];
+  const nlohmann::json b = nlohmann::json::parse(thrice.out)["results"][0];
+  EXPECT_FALSE(a.contains("seconds_warm_median"));
+  ASSERT_TRUE(b.contains("seconds_warm_median"));
+  EXPECT_EQ(b["warm_rounds"], 2);
+  EXPECT_GT(b["seconds_warm_min"].get<double>(), 0.0);
+  EXPECT_LE(b["seconds_warm_min"].get<double>(), b["seconds_warm_median"].get<double>());
+  // Repeating changes the timing, never the result: the judged volume is the same.
+  EXPECT_EQ(a["active_voxels"], b["active_voxels"]);
+  EXPECT_DOUBLE_EQ(a["q_global"].get<double>(), b["q_global"].get<double>());
+  EXPECT_NE(run_tomorig("bench recon --repeat 0 --grid 96,96,24,0.0195").exit_code, 0);
+}
+
 }  // namespace
 }  // namespace tomorig::testing
