@@ -15,6 +15,7 @@
 #include "commands.h"
 #include "record_layout.h"
 #include "rig_acquisition.h"
+#include "rig_run_options.h"
 #include "rig_status.h"
 #include "stop_signal.h"
 #include "tomorig/config/rig_config.h"
@@ -29,27 +30,15 @@ using std::chrono::duration;
 using std::chrono::duration_cast;
 
 struct AcquireOptions {
-  std::string config_path;
+  RigRunChoices rig;
   std::string to = "tcp://127.0.0.1:5555";
   bool connect = false;
   bool allow_remote = false;
-  std::optional<std::uint64_t> sets;
-  std::optional<double> duration_s;
-  std::string pace = "real-time";
-  std::string on_camera_loss = "stop";
-  std::vector<std::string> faults;
-  std::string status = "tcp://127.0.0.1:5556";
   double timeout_s = 10.0;
   double wait_s = 60.0;
 };
 
 double seconds_since(Clock::time_point t) { return duration<double>(Clock::now() - t).count(); }
-
-trigger::Pacing parse_pace(const std::string& text) {
-  if (text == "real-time") return trigger::Pacing::real_time;
-  if (text == "max") return trigger::Pacing::as_fast_as_consumed;
-  throw bad_input(fmt::format("--pace {} is not supported: use real-time or max", text));
-}
 
 // Sends one set, retrying while the recorder is absent or slow, up to `limit_s`; false if
 // `stop` (when given) was requested meanwhile and the set was not sent.
@@ -75,21 +64,8 @@ void acquire(const AcquireOptions& opt) {
   if (!(opt.timeout_s > 0.0) || !(opt.wait_s > 0.0))
     throw bad_input(fmt::format("--timeout {:g} / --wait {:g} are invalid: both must be > 0 seconds", opt.timeout_s,
                                 opt.wait_s));
-  if (opt.sets && *opt.sets < 1) throw bad_input(fmt::format("--sets {} is invalid: must be >= 1", *opt.sets));
-  const config::RigConfig rig = opt.config_path.empty() ? config::default_rig_config()
-                                                        : config::load_rig_config(opt.config_path);
-  const auto loss_policy = parse_camera_loss_policy(opt.on_camera_loss);
-  if (!loss_policy)
-    throw bad_input(fmt::format("--on-camera-loss {} is not supported: use stop or continue", opt.on_camera_loss));
-
-  RigAcquisitionOptions acquisition;
-  acquisition.sets = opt.sets;
-  acquisition.duration_s = opt.duration_s;
-  if (!opt.sets && !opt.duration_s && rig.simulation && rig.simulation->sets > 0)
-    acquisition.sets = static_cast<std::uint64_t>(rig.simulation->sets);
-  acquisition.pacing = parse_pace(opt.pace);
-  acquisition.on_camera_loss = *loss_policy;
-  for (const auto& fault : opt.faults) add_camera_fault(acquisition.faults, fault);
+  const config::RigConfig rig = load_rig(opt.rig);
+  const RigAcquisitionOptions acquisition = rig_acquisition_options(rig, opt.rig);
   RigAcquisition rig_run(rig, acquisition);  // a bad rig fails here, before anything is sent
 
   StopSignalGuard stop;
@@ -101,10 +77,9 @@ void acquire(const AcquireOptions& opt) {
   // The first line names the real endpoint (a "*" port resolved), for scripts and tests.
   fmt::print(stderr, "acquire: {} {}, rig '{}', {} cameras, {}\n", opt.connect ? "connected to" : "sending on",
              sender->endpoint(), rig.name, rig.cameras.size(),
-             acquisition.sets ? fmt::format("{} sets", *acquisition.sets)
-                              : (opt.duration_s ? fmt::format("{:g} s", *opt.duration_s) : std::string("until Ctrl-C")));
+             run_length_text(acquisition));
   std::fflush(stderr);
-  StatusReporter status("acquire", context, opt.status);
+  StatusReporter status("acquire", context, opt.rig.status);
   if (!status.endpoint().empty()) fmt::print(stderr, "acquire: status JSON on {}\n", status.endpoint());
 
   LossTally losses(rig_run.camera_ids());
@@ -170,25 +145,13 @@ void add_acquire_command(CLI::App& root) {
   auto opt = std::make_shared<AcquireOptions>();
   CLI::App* cmd = root.add_subcommand(
       "acquire", "Run trigger and cameras and stream the frame sets to 'tomorig record' (binds; the recorder connects)");
-  cmd->add_option("-c,--config", opt->config_path, "Rig file (TOML); default: the embedded rig")
-      ->check(CLI::ExistingFile);
+  add_rig_run_options(*cmd, opt->rig, "Acquire");
   cmd->add_option("--to", opt->to, "Stream endpoint (tcp://127.0.0.1:* picks a free port)")->capture_default_str();
   cmd->add_flag("--connect", opt->connect, "Connect --to instead of binding (the recorder binds)");
   cmd->add_flag("--allow-remote", opt->allow_remote, "Allow binding --to on a non-loopback address");
-  auto* sets = cmd->add_option("--sets", opt->sets,
-                               "Number of sets (default: simulation.sets of a simulated rig, else until Ctrl-C)");
-  cmd->add_option("--duration", opt->duration_s, "Acquire for this many seconds")->excludes(sets);
-  cmd->add_option("--pace", opt->pace, "Simulated trigger: real-time | max (as fast as the recorder takes them)")
-      ->capture_default_str();
-  cmd->add_option("--on-camera-loss", opt->on_camera_loss, "When a camera vanishes: stop | continue")
-      ->capture_default_str();
-  cmd->add_option("--status", opt->status, "Where the JSON status PUB socket binds; none: no socket")
-      ->capture_default_str();
   cmd->add_option("--timeout", opt->timeout_s, "Seconds a send may wait for the recorder before giving up")
       ->capture_default_str();
   cmd->add_option("--wait", opt->wait_s, "Seconds to wait for a recorder before the first set")->capture_default_str();
-  cmd->add_option("--inject-fault", opt->faults,
-                  "Testing: make a simulated camera fail, CAMERA:vanish-after=EVENTS (repeatable)");
   cmd->callback([opt] { acquire(*opt); });
 }
 

@@ -23,6 +23,7 @@
 #include "commands.h"
 #include "record_layout.h"
 #include "rig_acquisition.h"
+#include "rig_run_options.h"
 #include "rig_status.h"
 #include "stop_signal.h"
 #include "tomorig/config/rig_config.h"
@@ -41,16 +42,10 @@ using namespace std::chrono_literals;
 constexpr const char* kInprocEndpoint = "inproc://tomorig-run";
 
 struct RunOptions {
-  std::string config_path;
+  RigRunChoices rig;
   std::string out;
-  std::optional<std::uint64_t> sets;
-  std::optional<double> duration_s;
   std::string compression = "none";
   bool overwrite = false;
-  std::string pace = "real-time";
-  std::string on_camera_loss = "stop";
-  std::vector<std::string> faults;
-  std::string status = "tcp://127.0.0.1:5556";
   double disk_reserve_mb = 64.0;
 };
 
@@ -61,12 +56,6 @@ std::filesystem::path default_output_path() {
   char stamp[32];
   std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &utc);
   return std::filesystem::path("runs") / fmt::format("session-{}.h5", stamp);
-}
-
-trigger::Pacing parse_pace(const std::string& text) {
-  if (text == "real-time") return trigger::Pacing::real_time;
-  if (text == "max") return trigger::Pacing::as_fast_as_consumed;
-  throw bad_input(fmt::format("--pace {} is not supported: use real-time or max", text));
 }
 
 // Moves assembled sets from the rig into the lossless stream on its own thread, so the
@@ -121,28 +110,14 @@ std::string human_bytes(std::uintmax_t bytes) {
 }
 
 void run(const RunOptions& opt) {
-  config::RigConfig rig = opt.config_path.empty() ? config::default_rig_config()
-                                                  : config::load_rig_config(opt.config_path);
-  if (opt.sets && *opt.sets < 1) throw bad_input(fmt::format("--sets {} is invalid: must be >= 1", *opt.sets));
+  config::RigConfig rig = load_rig(opt.rig);
   const auto compression = storage::parse_compression(opt.compression);
   if (!compression)
     throw bad_input(fmt::format("--compression {} is not supported (none, bitshuffle-lz4)", opt.compression));
-  const auto loss_policy = parse_camera_loss_policy(opt.on_camera_loss);
-  if (!loss_policy)
-    throw bad_input(fmt::format("--on-camera-loss {} is not supported: use stop or continue", opt.on_camera_loss));
   if (!(opt.disk_reserve_mb >= 0.0))
     throw bad_input(fmt::format("--disk-reserve-mb {:g} is invalid: it must be >= 0", opt.disk_reserve_mb));
 
-  RigAcquisitionOptions acquisition;
-  acquisition.sets = opt.sets;
-  acquisition.duration_s = opt.duration_s;
-  // A simulated rig records its configured number of sets unless told otherwise; a camera rig
-  // runs until Ctrl-C.
-  if (!opt.sets && !opt.duration_s && rig.simulation && rig.simulation->sets > 0)
-    acquisition.sets = static_cast<std::uint64_t>(rig.simulation->sets);
-  acquisition.pacing = parse_pace(opt.pace);
-  acquisition.on_camera_loss = *loss_policy;
-  for (const auto& fault : opt.faults) add_camera_fault(acquisition.faults, fault);
+  RigAcquisitionOptions acquisition = rig_acquisition_options(rig, opt.rig);
   acquisition.keep_truth = true;
 
   const std::filesystem::path out = opt.out.empty() ? default_output_path() : std::filesystem::path(opt.out);
@@ -178,8 +153,7 @@ void run(const RunOptions& opt) {
   if (sizes_known) open_writer();  // otherwise the first set tells the image sizes
 
   fmt::print("tomorig run: rig '{}', {} cameras, {}{}\n", rig.name, rig.cameras.size(),
-             acquisition.sets ? fmt::format("{} sets", *acquisition.sets)
-                              : (opt.duration_s ? fmt::format("{:g} s", *opt.duration_s) : std::string("until Ctrl-C")),
+             run_length_text(acquisition),
              rig.simulation ? fmt::format(", case {} at {} ppp", rig.simulation->case_name, rig.simulation->ppp)
                             : std::string());
   std::fflush(stdout);
@@ -192,7 +166,7 @@ void run(const RunOptions& opt) {
   stream::SocketOptions push = pull;
   push.endpoint.bind = false;
   stream::FrameSender sender(context, push);
-  StatusReporter status("recording", context, opt.status);
+  StatusReporter status("recording", context, opt.rig.status);
   if (!status.endpoint().empty()) fmt::print(stderr, "run: status JSON on {}\n", status.endpoint());
 
   // Ctrl-C ends the run between sets: acquisition stops, the sets already taken are recorded,
@@ -288,28 +262,13 @@ void add_run_command(CLI::App& root) {
   CLI::App* cmd = root.add_subcommand(
       "run", "Run the rig: trigger, acquire and record a session (default: the embedded simulated "
              "4-camera tpiv-thesis rig)");
-  cmd->add_option("-c,--config", opt->config_path, "Rig file (TOML); default: the embedded rig")
-      ->check(CLI::ExistingFile);
+  add_rig_run_options(*cmd, opt->rig, "Record");
   cmd->add_option("-o,--out", opt->out, "Session file to write; default: runs/session-<UTC time>.h5");
-  auto* sets = cmd->add_option("--sets", opt->sets,
-                               "Number of double-frame sets to record (default: simulation.sets of a simulated rig, "
-                               "else until Ctrl-C)");
-  cmd->add_option("--duration", opt->duration_s, "Record for this many seconds")->excludes(sets);
   cmd->add_option("--compression", opt->compression, "Frame compression: none | bitshuffle-lz4");
   cmd->add_flag("--overwrite", opt->overwrite, "Replace an existing output file");
-  cmd->add_option("--pace", opt->pace,
-                  "Simulated trigger: real-time (events at the rig's rate) | max (as fast as the recorder takes them)")
-      ->capture_default_str();
-  cmd->add_option("--on-camera-loss", opt->on_camera_loss,
-                  "When a camera vanishes: stop (keep what was recorded) | continue (record its frames as missing)")
-      ->capture_default_str();
-  cmd->add_option("--status", opt->status, "Where the JSON status PUB socket binds; none: no socket")
-      ->capture_default_str();
   cmd->add_option("--disk-reserve-mb", opt->disk_reserve_mb,
                   "Stop recording cleanly when the disk would have less than this many MB free")
       ->capture_default_str();
-  cmd->add_option("--inject-fault", opt->faults,
-                  "Testing: make a simulated camera fail, CAMERA:vanish-after=EVENTS (repeatable)");
   cmd->callback([opt] { run(*opt); });
 }
 
