@@ -39,6 +39,8 @@ struct BenchReconArgs {
   double relaxation = 1.0;
   double mlos_threshold = 0.05;
   double prune_fraction = -1.0;  // < 0: the library default
+  double sigma_px = 0.0;          // weight sigma, all cameras; 0: the library default
+  int patch = 0;                  // patch edge p; 0: the library default (ceil(4 sigma), odd)
   int repeat = 1;                 // rounds per algorithm; rounds after the first are "warm"
   std::string initial = "mlos";  // SMART/FMART start: MLOS intensities or 1 ("uniform", as the thesis)
   std::string grid;
@@ -173,6 +175,7 @@ void run(const BenchReconArgs& args) {
   base.mlos_threshold = args.mlos_threshold;
   if (args.prune_fraction >= 0) base.prune_fraction = args.prune_fraction;
   base.mlos_initial_intensity = args.initial == "mlos";
+  base.patch_size = args.patch;
   base.threads = args.threads;
   if (args.iterations > 0) base.max_iterations = args.iterations;
   for (const std::string& a : args.algorithms) {  // refuse a typo before minutes of work
@@ -210,6 +213,7 @@ void run(const BenchReconArgs& args) {
         input.sensor_sizes.push_back({rig.cameras()[c].spec.width, rig.cameras()[c].spec.height});
       }
       input.grid = grid;
+      if (args.sigma_px > 0) input.psf.assign(input.cameras.size(), recon::PsfModel::constant(args.sigma_px));
       return input;
     };
     // Q needs the dense truth volume (and the quality code's own dense copies): judge only
@@ -309,6 +313,8 @@ void run(const BenchReconArgs& args) {
                               {"mlos_threshold", args.mlos_threshold},
                               {"prune_fraction", base_prune_fraction(args)},
                               {"initial_intensity", args.initial},
+                              {"sigma_px", args.sigma_px > 0 ? nlohmann::json(args.sigma_px) : nlohmann::json("default")},
+                              {"patch", args.patch},
                               {"seed", args.seed},
                               {"machine", machine_json()},
                               {"results", results},
@@ -333,6 +339,13 @@ void add_bench_recon_command(CLI::App& bench) {
   cmd->add_option("--prune", args->prune_fraction,
                   "SMART/FMART: drop voxels below this fraction of the largest intensity after each iteration "
                   "(0: never; negative: the library default)")
+      ->capture_default_str();
+  cmd->add_option("--sigma-px", args->sigma_px,
+                  "Gaussian sigma of the voxel-to-pixel weights, pixels, all cameras (0: the library default)")
+      ->check(CLI::Range(0.0, 10.0))
+      ->capture_default_str();
+  cmd->add_option("--patch", args->patch, "Patch edge p of SMART/FMART/MART (0: ceil(4 sigma), odd, >= 3)")
+      ->check(CLI::Range(0, 15))
       ->capture_default_str();
   cmd->add_option("--repeat", args->repeat,
                   "Reconstruct each case this many times: 'seconds' is the first (cold) round, "

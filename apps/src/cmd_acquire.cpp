@@ -16,6 +16,7 @@
 #include "record_layout.h"
 #include "rig_acquisition.h"
 #include "rig_run_options.h"
+#include "send_with_retry.h"
 #include "rig_status.h"
 #include "stop_signal.h"
 #include "tomorig/config/rig_config.h"
@@ -37,28 +38,6 @@ struct AcquireOptions {
   double timeout_s = 10.0;
   double wait_s = 60.0;
 };
-
-double seconds_since(Clock::time_point t) { return duration<double>(Clock::now() - t).count(); }
-
-// Sends one set, retrying while the recorder is absent or slow, up to `limit_s`; false if
-// `stop` (when given) was requested meanwhile and the set was not sent.
-bool send_set(stream::FrameSender& sender, const FrameSet& set, double limit_s, const StopSignalGuard* stop) {
-  const auto begin = Clock::now();
-  for (;;) {
-    try {
-      if (sender.send(set)) return true;
-    } catch (const zmq::error_t& e) {
-      if (e.num() != EINTR)
-        throw runtime_error(fmt::format("sending set {} on {} failed: {}", set.set_index, sender.endpoint(), e.what()));
-    }
-    if (stop != nullptr && stop->stop_requested()) return false;
-    if (seconds_since(begin) >= limit_s)
-      throw runtime_error(fmt::format(
-          "no recorder took set {} within {:g} s on {}: is 'tomorig record --from {}' running? (raise --timeout for a "
-          "slow recorder, or --wait for the first set)",
-          set.set_index, limit_s, sender.endpoint(), sender.endpoint()));
-  }
-}
 
 void acquire(const AcquireOptions& opt) {
   if (!(opt.timeout_s > 0.0) || !(opt.wait_s > 0.0))
@@ -112,11 +91,12 @@ void acquire(const AcquireOptions& opt) {
     const bool first = sender->stats().sets_sent == 0;
     // Ctrl-C interrupts a wait for the recorder; the set in hand and those already acquired
     // still go out, each with the normal timeout.
-    if (!send_set(*sender, *set, first ? opt.wait_s : opt.timeout_s, stopped_by.empty() ? &stop : nullptr)) {
+    if (send_with_retry(*sender, *set, first ? opt.wait_s : opt.timeout_s, stopped_by.empty() ? &stop : nullptr) ==
+        SendOutcome::stopped) {
       stopped_by = stop.signal_name();
       figures.state = "stopping";
       rig_run.request_stop();
-      send_set(*sender, *set, opt.timeout_s, nullptr);
+      send_with_retry(*sender, *set, opt.timeout_s, nullptr);
     }
     losses.add(*set);
     ++figures.sets;

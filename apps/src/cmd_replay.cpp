@@ -15,6 +15,7 @@
 
 #include "commands.h"
 #include "replay_schedule.h"
+#include "send_with_retry.h"
 #include "stop_signal.h"
 #include "tomorig/core/error.h"
 #include "tomorig/storage/session_file.h"
@@ -65,28 +66,6 @@ class ReplayStatus {
   std::uint64_t last_sets_ = 0, last_bytes_ = 0;
 };
 
-enum class SendOutcome { sent, stopped };
-
-// Sends one set, retrying while the receiver is absent or slow, up to `limit`. A signal
-// interrupts ZeroMQ's wait (EINTR); then the stop flag decides.
-SendOutcome send_set(stream::FrameSender& sender, const FrameSet& set, double limit_s, const StopSignalGuard& stop) {
-  const auto begin = Clock::now();
-  for (;;) {
-    try {
-      if (sender.send(set)) return SendOutcome::sent;
-    } catch (const zmq::error_t& e) {
-      if (e.num() != EINTR)
-        throw runtime_error(fmt::format("sending set {} on {} failed: {}", set.set_index, sender.endpoint(), e.what()));
-    }
-    if (stop.stop_requested()) return SendOutcome::stopped;
-    if (seconds_since(begin) >= limit_s)
-      throw runtime_error(fmt::format(
-          "no receiver took set {} within {:g} s on {}: the receiver vanished or stalled (is 'tomorig record "
-          "--from {}' running? for a slow receiver raise --timeout, or --wait for the first set)",
-          set.set_index, limit_s, sender.endpoint(), sender.endpoint()));
-  }
-}
-
 void replay(const ReplayOptions& opt) {
   if (!(opt.timeout_s > 0.0) || !(opt.wait_s > 0.0))
     throw bad_input(fmt::format("--timeout {:g} / --wait {:g} are invalid: both must be > 0 seconds", opt.timeout_s,
@@ -125,7 +104,7 @@ void replay(const ReplayOptions& opt) {
       set.set_index = i;
       const std::uint64_t blocked_before = sender->stats().blocked_sends;
       const bool first = sender->stats().sets_sent == 0;
-      stopped = send_set(*sender, set, first ? opt.wait_s : opt.timeout_s, stop) == SendOutcome::stopped;
+      stopped = send_with_retry(*sender, set, first ? opt.wait_s : opt.timeout_s, &stop) == SendOutcome::stopped;
       if (sender->stats().blocked_sends != blocked_before) ++blocked_sets;
       status.update(sender->stats(), blocked_sets);
     }

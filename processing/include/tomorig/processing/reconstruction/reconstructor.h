@@ -39,7 +39,9 @@ struct ReconstructionInput {
   // camera uses PsfModel::constant(0.5). A voxel blob of width sigma_b imaged through weights of
   // sigma_w gives particle images of sqrt(sigma_w^2 + sigma_b^2), so weights as wide as the
   // particle images (0.75 px in tpiv-thesis) make blobs too sharp; sigma_w = 0.5 reproduces
-  // them from blobs of ~0.6 voxel (docs/reconstruction.md has the measurements).
+  // them from blobs of ~0.6 voxel and gives the best unsmoothed volumes. Volumes that will be
+  // smoothed (the thesis's FMART evaluation) do better with sigma_w = 0.6: fewer ghosts, and
+  // the smoothing restores the blob width (docs/reconstruction.md has the measurements).
   std::vector<PsfModel> psf;
   // The sensor sizes the calibration was made for, one per camera, or empty: not checked.
   // (CameraModel does not carry a size; the calibration file does.)
