@@ -99,11 +99,11 @@ void run(const Piv3dArgs& args) {
                                  .parameters_json = parameters.dump(),
                                  .voxel_size_mm = ga.voxel_size},
                                 {.overwrite = true});
-  writer.add(std::move(result));
+  writer.add(result);
+  writer.close();
   const nlohmann::json summary = {{"out", args.out},
                                   {"xdmf", storage::ResultsWriter::sidecar_path(args.out).string()},
-                                  {"nodes", {writer.sets().back().field.nx, writer.sets().back().field.ny,
-                                             writer.sets().back().field.nz}},
+                                  {"nodes", {result.field.nx, result.field.ny, result.field.nz}},
                                   {"correlation", to_json(report)}};
   if (args.json) fmt::print("{}\n", summary.dump(2));
   else

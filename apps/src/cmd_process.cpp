@@ -138,25 +138,19 @@ void run(const ProcessArgs& args) {
   if (session.set_count() == 0) throw bad_input(fmt::format("session '{}' holds no set to process", args.session));
   const SessionCameras cameras = session_cameras(session, args.calib);
 
-  recon::ReconstructionOptions recon_options;
-  recon_options.algorithm = args.algorithm;
-  recon_options.relaxation = args.relaxation;
-  recon_options.threads = args.threads;
-  if (!session.info().rig_config_toml.empty()) {
-    const config::RigConfig rig = config::parse_rig_config(session.info().rig_config_toml, args.session + ":/config");
-    recon_options.max_iterations = rig.processing.iterations;
-  }
-  if (recon_options.algorithm.empty()) recon_options.algorithm = "fmart";
-  if (args.iterations > 0) recon_options.max_iterations = args.iterations;
-  recon_options.validate();
+  // The rig config's processing.algorithm is deliberately not used: `process` reconstructs with
+  // FMART unless --algorithm says otherwise (issue 5).
+  ReconstructionSetup setup = reconstruction_setup(session, args.session, cameras,
+                                                   {.algorithm = args.algorithm,
+                                                    .algorithm_from_rig = false,
+                                                    .iterations = args.iterations,
+                                                    .relaxation = args.relaxation,
+                                                    .threads = args.threads,
+                                                    .grid = args.grid,
+                                                    .sigma_px = args.sigma_px});
+  const recon::ReconstructionOptions& recon_options = setup.options;
   const auto reconstructor = recon::make_reconstructor(recon_options);
-
-  recon::ReconstructionInput input;
-  input.cameras = cameras.pointers();
-  input.grid = args.grid.empty() ? grid_from_session(session) : parse_grid(args.grid);
-  input.psf.assign(input.cameras.size(), recon::PsfModel::constant(args.sigma_px));
-  for (const storage::SessionCamera& c : session.info().cameras) input.sensor_sizes.push_back({c.width, c.height});
-  input.psf.front().validate("--sigma-px");
+  const recon::ReconstructionInput& input = setup.input;
 
   CorrelationArgs corr_args = args.correlation;
   corr_args.threads = args.threads;
@@ -256,11 +250,11 @@ void run(const ProcessArgs& args) {
     result.dt_ns = r.dt_ns;
     result.report_json = nlohmann::json{{"reconstruction", r.reports}, {"correlation", to_json(report)}}.dump();
     result.seconds = std::chrono::duration<double>(Clock::now() - r.started).count();
-    writer.add(std::move(result));
+    writer.add(result);
     valid_sum += report.valid_fraction();
     ++processed;
     fmt::print(stderr, "\rset {} done: {} vectors, {:.1f} % valid, {:.1f} s\n", r.index, report.valid + report.replaced + report.invalid,
-               100.0 * report.valid_fraction(), writer.sets().back().seconds);
+               100.0 * report.valid_fraction(), result.seconds);
     progress.set_done();
     return !stop_signal.stop_requested();
   };
@@ -275,14 +269,15 @@ void run(const ProcessArgs& args) {
   }
 
   const double seconds = std::chrono::duration<double>(Clock::now() - started).count();
-  const std::uint64_t in_file = writer.sets().size();
+  const std::uint64_t in_file = writer.set_count();
   if (stop_signal.stop_requested())
     throw runtime_error(fmt::format("interrupted by {}: '{}' is valid and holds {} of {} sets; run the same command "
                                     "again to resume",
                                     stop_signal.signal_name(), args.out, in_file, set_total));
 
   // Summary: the mean field over the file's sets.
-  const storage::EnsembleStatistics stats = storage::EnsembleStatistics::compute(writer.sets(), input.grid.voxel_size);
+  writer.close();  // errors surface here rather than in the destructor
+  const storage::EnsembleStatistics stats = writer.statistics();
   double speed = 0.0;
   std::size_t nodes = 0;
   Vec3d sum, sum2;  // of the mean displacement over the nodes: its spatial mean and spread

@@ -71,27 +71,18 @@ void run(const ReconstructArgs& args) {
                                 session.set_count() == 0 ? 0 : session.set_count() - 1));
   const SessionCameras cameras = session_cameras(session, args.calib);
 
-  recon::ReconstructionOptions options;
-  options.algorithm = args.algorithm;
-  options.relaxation = args.relaxation;
-  options.mlos_threshold = args.mlos_threshold;
-  options.threads = args.threads;
-  if (!session.info().rig_config_toml.empty()) {
-    const config::RigConfig rig = config::parse_rig_config(session.info().rig_config_toml, args.session + ":/config");
-    if (options.algorithm.empty()) options.algorithm = rig.processing.algorithm;
-    options.max_iterations = rig.processing.iterations;
-  }
-  if (options.algorithm.empty()) options.algorithm = "fmart";
-  if (args.iterations > 0) options.max_iterations = args.iterations;
-  options.validate();
+  ReconstructionSetup setup = reconstruction_setup(session, args.session, cameras,
+                                                   {.algorithm = args.algorithm,
+                                                    .algorithm_from_rig = true,
+                                                    .iterations = args.iterations,
+                                                    .relaxation = args.relaxation,
+                                                    .mlos_threshold = args.mlos_threshold,
+                                                    .threads = args.threads,
+                                                    .grid = args.grid,
+                                                    .sigma_px = args.sigma_px});
+  const recon::ReconstructionOptions& options = setup.options;
   const auto reconstructor = recon::make_reconstructor(options);
-
-  recon::ReconstructionInput input;
-  input.cameras = cameras.pointers();
-  input.grid = args.grid.empty() ? grid_from_session(session) : parse_grid(args.grid);
-  input.psf.assign(input.cameras.size(), recon::PsfModel::constant(args.sigma_px));
-  for (const storage::SessionCamera& c : session.info().cameras) input.sensor_sizes.push_back({c.width, c.height});
-  input.psf.front().validate("--sigma-px");
+  recon::ReconstructionInput& input = setup.input;
 
   const FrameSet set = session.read_set(args.set);
   nlohmann::json parameters = {{"algorithm", options.algorithm},

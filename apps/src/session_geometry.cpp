@@ -136,4 +136,30 @@ VoxelGrid parse_grid(const std::string& text) {
                       centre);
 }
 
+ReconstructionSetup reconstruction_setup(const storage::SessionReader& session, const std::string& session_path,
+                                         const SessionCameras& cameras, const ReconstructionChoices& choices) {
+  ReconstructionSetup setup;
+  recon::ReconstructionOptions& options = setup.options;
+  options.algorithm = choices.algorithm;
+  options.relaxation = choices.relaxation;
+  options.mlos_threshold = choices.mlos_threshold;
+  options.threads = choices.threads;
+  if (!session.info().rig_config_toml.empty()) {
+    const config::RigConfig rig = config::parse_rig_config(session.info().rig_config_toml, session_path + ":/config");
+    if (options.algorithm.empty() && choices.algorithm_from_rig) options.algorithm = rig.processing.algorithm;
+    options.max_iterations = rig.processing.iterations;
+  }
+  if (options.algorithm.empty()) options.algorithm = "fmart";
+  if (choices.iterations > 0) options.max_iterations = choices.iterations;
+  options.validate();
+
+  recon::ReconstructionInput& input = setup.input;
+  input.cameras = cameras.pointers();
+  input.grid = choices.grid.empty() ? grid_from_session(session) : parse_grid(choices.grid);
+  input.psf.assign(input.cameras.size(), recon::PsfModel::constant(choices.sigma_px));
+  for (const storage::SessionCamera& c : session.info().cameras) input.sensor_sizes.push_back({c.width, c.height});
+  if (!input.psf.empty()) input.psf.front().validate("--sigma-px");
+  return setup;
+}
+
 }  // namespace tomorig::app

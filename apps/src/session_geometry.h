@@ -9,6 +9,7 @@
 
 #include "tomorig/core/volume.h"
 #include "tomorig/processing/calibration/camera_model.h"
+#include "tomorig/processing/reconstruction/reconstructor.h"
 #include "tomorig/storage/session_file.h"
 
 namespace tomorig::app {
@@ -40,5 +41,29 @@ VoxelGrid grid_from_session(const storage::SessionReader& session);
 // "nx,ny,nz,voxel_mm" or "nx,ny,nz,voxel_mm,cx,cy,cz" (cx..cz: grid centre, mm; default 0).
 // Throws tomorig::Error (bad_input) quoting `text` and the expected form.
 VoxelGrid parse_grid(const std::string& text);
+
+// The command-line side of a reconstruction set-up (`reconstruct`, `process`).
+struct ReconstructionChoices {
+  std::string algorithm;  // empty: the default below
+  // true (`reconstruct`): an empty algorithm takes the rig config's processing.algorithm. false
+  // (`process`): the rig's choice is ignored and FMART is the default, as issue 5 asks.
+  bool algorithm_from_rig = true;
+  int iterations = 0;     // 0: the rig config's processing.iterations
+  double relaxation = 1.0;
+  double mlos_threshold = 0.05;
+  int threads = 0;
+  std::string grid;       // empty: the rig config's [grid]; else as parse_grid
+  double sigma_px = 0.5;
+};
+
+// Validated options and an input holding the cameras, grid, PSF and sensor sizes (images left
+// to the caller), from the session's rig config and `choices`. Throws tomorig::Error (bad_input)
+// naming the option that is wrong.
+struct ReconstructionSetup {
+  recon::ReconstructionOptions options;
+  recon::ReconstructionInput input;
+};
+ReconstructionSetup reconstruction_setup(const storage::SessionReader& session, const std::string& session_path,
+                                         const SessionCameras& cameras, const ReconstructionChoices& choices);
 
 }  // namespace tomorig::app

@@ -14,8 +14,18 @@ struct XdmfFieldGrid {
   Vec3d origin, spacing;  // mm
 };
 
-// `file_name`: the HDF5 file's name relative to the .xdmf; `sets`: the set names under /sets.
+// Format version 1. `file_name`: the HDF5 file's name relative to the .xdmf; `sets`: the set
+// names under /sets.
 std::string xdmf_for_results(const std::string& file_name, const XdmfFieldGrid& grid,
                              const std::vector<std::string>& sets, bool has_statistics);
+
+// Format version 2: each set is a row of the /sets datasets (`rows` long), selected by an XDMF
+// hyperslab.
+struct XdmfSetRow {
+  std::uint64_t set_index = 0;
+  std::uint64_t row = 0;
+};
+std::string xdmf_for_result_rows(const std::string& file_name, const XdmfFieldGrid& grid,
+                                 const std::vector<XdmfSetRow>& sets, std::uint64_t rows, bool has_statistics);
 
 }  // namespace tomorig::storage

@@ -1,12 +1,18 @@
 // Results files: round trip of vector fields, ensemble statistics with physical units, resume,
 // refusal of another session's file, and a write failure that must lose no finished set.
 #include <gtest/gtest.h>
+#include <hdf5.h>
 #include <signal.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <string>
+#include <vector>
 
 #include "temp_dir.h"
 #include "tomorig/core/error.h"
@@ -75,7 +81,10 @@ TEST(ResultsFile, RoundTripsFieldsFlagsPeaksAndNodePositions) {
   EXPECT_THROW(r.read_set(4), Error);
 
   const std::string xdmf = read_text_file(ResultsWriter::sidecar_path(path));
-  EXPECT_NE(xdmf.find("r.h5:/sets/000005/velocity_m_s"), std::string::npos);
+  // Set 5 is row 1 of the /sets datasets: a hyperslab starting there.
+  EXPECT_NE(xdmf.find("set 000005"), std::string::npos);
+  EXPECT_NE(xdmf.find("1 0 0 0 0 1 1 1 1 1 1 2 3 4 3</DataItem>"), std::string::npos) << xdmf;
+  EXPECT_NE(xdmf.find("r.h5:/sets/velocity_m_s"), std::string::npos);
   EXPECT_NE(xdmf.find("r.h5:/statistics/mean_velocity_m_s"), std::string::npos);
   EXPECT_NE(xdmf.find("Dimensions=\"2 3 4 3\""), std::string::npos);
 }
@@ -148,13 +157,30 @@ TEST(ResultsFile, RefusesBadSets) {
   EXPECT_THROW(ResultsWriter(dir / "r.h5", {.session_identity = "x", .voxel_size_mm = 0}), Error);
 }
 
-// A real write failure part-way through the file: the file-size limit (what a full disk looks
-// like to the writer: write() fails) is set just above the size of the file with one set.
+// A larger field (40 x 40 x 20 nodes, ~0.9 MB per set in the file) whose x displacement is
+// the set index, so that every set can be recognised after a crash.
+SetResult big_set(std::uint64_t index) {
+  SetResult r;
+  r.set_index = index;
+  r.dt_ns = kDtNs;
+  r.field = VectorField(40, 40, 20);
+  r.field.spacing = {0.1, 0.1, 0.1};
+  for (std::size_t n = 0; n < r.field.count(); ++n) {
+    r.field.displacement[n] = {static_cast<float>(index), 0.5f, -0.25f};
+    r.field.status[n] = VectorStatus::valid;
+    r.field.peak[n] = 0.7f;
+  }
+  r.report_json = "{\"set\":" + std::to_string(index) + "}";
+  return r;
+}
+
+// A real write failure part-way through a set: the file-size limit (what a full disk looks
+// like to the writer: write() fails) is set to the size of the file with one set.
 TEST(ResultsFile, WriteFailureMidFileLosesNoFinishedSet) {
   TempDir dir;
   const auto path = dir / "r.h5";
   ResultsWriter w(path, info());
-  w.add(set_with(0, 1.0f));
+  w.add(big_set(0));
   const auto size = std::filesystem::file_size(path);
 
   struct sigaction ignore {}, previous {};
@@ -163,27 +189,249 @@ TEST(ResultsFile, WriteFailureMidFileLosesNoFinishedSet) {
   rlimit old{};
   getrlimit(RLIMIT_FSIZE, &old);
   rlimit limited = old;
-  limited.rlim_cur = size + 512;
+  limited.rlim_cur = size;  // the set is appended in place: growing the file by a set fails
   ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limited), 0);
   bool threw = false;
   try {
-    SetResult big = set_with(1, 2.0f);
-    w.add(std::move(big));
+    w.add(big_set(1));
   } catch (const Error& e) {
     threw = true;
     EXPECT_EQ(e.kind(), ErrorKind::runtime);
-    EXPECT_NE(std::string(e.what()).find("unchanged"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("holds the 1 sets finished before"), std::string::npos) << e.what();
   }
   setrlimit(RLIMIT_FSIZE, &old);
   sigaction(SIGXFSZ, &previous, nullptr);
   EXPECT_TRUE(threw);
+  EXPECT_FALSE(w.has_set(1));
   EXPECT_FALSE(std::filesystem::exists(dir / "r.h5.partial"));
-  const ResultsReader r(path);
-  EXPECT_EQ(r.set_indices(), std::vector<std::uint64_t>{0});
-  EXPECT_FLOAT_EQ(r.read_set(0).field.displacement[3].x, 1.0f);
+  {
+    const ResultsReader r(path);
+    EXPECT_EQ(r.set_indices(), std::vector<std::uint64_t>{0});
+    EXPECT_FLOAT_EQ(r.read_set(0).field.displacement[3].y, 0.5f);
+  }
   // The writer stays usable once space is back.
-  w.add(set_with(1, 2.0f));
-  EXPECT_EQ(ResultsReader(path).set_indices().size(), 2u);
+  w.add(big_set(1));
+  w.close();
+  const ResultsReader r(path);
+  EXPECT_EQ(r.set_indices(), (std::vector<std::uint64_t>{0, 1}));
+  EXPECT_FLOAT_EQ(r.read_set(1).field.displacement[3].x, 1.0f);
+}
+
+// File address and bytes of set 0's displacement chunk (one set per chunk).
+std::pair<haddr_t, std::string> first_chunk(const std::filesystem::path& path) {
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  EXPECT_GE(file, 0);
+  const hid_t d = H5Dopen2(file, "/sets/displacement_voxel", H5P_DEFAULT);
+  EXPECT_GE(d, 0);
+  const hsize_t origin[5] = {0, 0, 0, 0, 0};
+  unsigned mask = 0;
+  haddr_t address = HADDR_UNDEF;
+  hsize_t size = 0;
+  EXPECT_GE(H5Dget_chunk_info_by_coord(d, origin, &mask, &address, &size), 0);
+  H5Dclose(d);
+  H5Fclose(file);
+  std::string bytes(size, '\0');
+  std::ifstream in(path, std::ios::binary);
+  in.seekg(static_cast<std::streamoff>(address));
+  in.read(bytes.data(), static_cast<std::streamsize>(size));
+  return {address, bytes};
+}
+
+// O(set) appends: each set grows the file by about one set's size whatever the number of sets
+// before it, and set 0's data stays where and as it was written.
+TEST(ResultsFile, AppendingASetDoesNotRewriteEarlierSets) {
+  TempDir dir;
+  const auto path = dir / "r.h5";
+  const double set_bytes = 40.0 * 40 * 20 * (12 + 12 + 1 + 4);
+  ResultsWriter w(path, info());
+  w.add(big_set(0));
+  const auto [address, bytes] = first_chunk(path);
+  ASSERT_NE(address, HADDR_UNDEF);
+  std::vector<double> growth;
+  auto size = std::filesystem::file_size(path);
+  for (std::uint64_t i = 1; i <= 8; ++i) {
+    w.add(big_set(i));
+    const auto now = std::filesystem::file_size(path);
+    growth.push_back(static_cast<double>(now) - static_cast<double>(size));
+    size = now;
+  }
+  for (const double g : growth) {
+    EXPECT_GT(g, 0.9 * set_bytes);
+    EXPECT_LT(g, 1.2 * set_bytes);  // a rewrite would grow by all the sets before
+  }
+  const auto [address_after, bytes_after] = first_chunk(path);
+  EXPECT_EQ(address_after, address);
+  EXPECT_TRUE(bytes_after == bytes);
+  w.close();
+  const ResultsReader r(path);
+  EXPECT_EQ(r.format_version(), 2);
+  EXPECT_EQ(r.set_indices().size(), 9u);
+  EXPECT_FLOAT_EQ(r.read_set(7).field.displacement[100].x, 7.0f);
+  EXPECT_EQ(r.read_set(7).report_json, "{\"set\":7}");
+}
+
+// A writer killed (SIGKILL) at whatever point of an append it has reached: the file opens and
+// holds every set whose add() returned, and a new writer resumes it. Three rounds on one file,
+// each killed after a different number of sets.
+TEST(ResultsFile, SigkillMidAppendKeepsEveryFinishedSet) {
+  TempDir dir;
+  const auto path = dir / "r.h5";
+  std::uint64_t next = 0;
+  for (int round = 1; round <= 3; ++round) {
+    int fds[2];
+    ASSERT_EQ(pipe(fds), 0);
+    const std::uint64_t first = next;
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {  // appends sets until killed, telling the parent after each one
+      close(fds[0]);
+      try {
+        ResultsWriter w(path, info());
+        for (std::uint64_t i = first;; ++i) {
+          w.add(big_set(i));
+          const char done = 1;
+          if (write(fds[1], &done, 1) != 1) _exit(3);
+        }
+      } catch (...) {
+        _exit(2);
+      }
+    }
+    close(fds[1]);
+    std::uint64_t finished = 0;
+    char done = 0;
+    while (finished < static_cast<std::uint64_t>(round) && read(fds[0], &done, 1) == 1) ++finished;
+    kill(child, SIGKILL);  // the child is somewhere in the next add()
+    int status = 0;
+    waitpid(child, &status, 0);
+    while (read(fds[0], &done, 1) == 1) ++finished;  // sets it finished before the signal landed
+    close(fds[0]);
+    ASSERT_TRUE(WIFSIGNALED(status)) << "the writer failed by itself, status " << status;
+    ASSERT_EQ(finished, static_cast<std::uint64_t>(round));
+
+    const ResultsReader r(path);  // opens although its writer died
+    const auto indices = r.set_indices();
+    ASSERT_GE(indices.size(), first + finished);  // every finished set (perhaps the one being written too)
+    for (std::uint64_t i = 0; i < first + finished; ++i) {
+      ASSERT_TRUE(std::binary_search(indices.begin(), indices.end(), i)) << "set " << i << " lost";
+      EXPECT_FLOAT_EQ(r.read_set(i).field.displacement[5].x, static_cast<float>(i));
+    }
+    next = indices.back() + 1;
+  }
+  ResultsWriter resumed(path, info());
+  EXPECT_EQ(resumed.resumed_sets(), next);
+  resumed.add(big_set(next));
+  resumed.close();
+  const ResultsReader r(path);
+  EXPECT_EQ(r.set_indices().size(), next + 1);
+  const auto s = r.statistics();
+  EXPECT_NEAR(s.mean_displacement_voxel[0].x, static_cast<double>(next) / 2.0, 1e-9);  // mean of 0 .. next
+}
+
+// A results file written by hand in layout version 1 (one group per set), or with a version
+// from the future.
+void write_string_attr(hid_t object, const char* name, const std::string& value) {
+  const hid_t type = H5Tcopy(H5T_C_S1);
+  H5Tset_size(type, H5T_VARIABLE);
+  H5Tset_cset(type, H5T_CSET_UTF8);
+  const hid_t space = H5Screate(H5S_SCALAR);
+  const hid_t a = H5Acreate2(object, name, type, space, H5P_DEFAULT, H5P_DEFAULT);
+  const char* text = value.c_str();
+  H5Awrite(a, type, &text);
+  H5Aclose(a);
+  H5Sclose(space);
+  H5Tclose(type);
+}
+void write_number_attr(hid_t object, const char* name, hid_t type, const void* value, hsize_t n = 1) {
+  const hid_t space = n == 1 ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &n, nullptr);
+  const hid_t a = H5Acreate2(object, name, type, space, H5P_DEFAULT, H5P_DEFAULT);
+  H5Awrite(a, type, value);
+  H5Aclose(a);
+  H5Sclose(space);
+}
+void write_array(hid_t group, const char* name, hid_t type, std::vector<hsize_t> dims, const void* data) {
+  const hid_t space = H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr);
+  const hid_t d = H5Dcreate2(group, name, type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  H5Dwrite(d, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data);
+  H5Dclose(d);
+  H5Sclose(space);
+}
+void write_string_dataset(hid_t group, const char* name, const std::string& value) {
+  const hid_t type = H5Tcopy(H5T_C_S1);
+  H5Tset_size(type, H5T_VARIABLE);
+  const hid_t space = H5Screate(H5S_SCALAR);
+  const hid_t d = H5Dcreate2(group, name, type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  const char* text = value.c_str();
+  H5Dwrite(d, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, &text);
+  H5Dclose(d);
+  H5Sclose(space);
+  H5Tclose(type);
+}
+
+void write_old_file(const std::filesystem::path& path, int version) {
+  const hid_t file = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  write_string_attr(file, "format", "tomorig-results");
+  write_number_attr(file, "format_version", H5T_NATIVE_INT, &version);
+  write_string_attr(file, "software_version", "0.1.0");
+  write_string_attr(file, "session_path", "s.h5");
+  write_string_attr(file, "session_identity", "session-1");
+  const double voxel = kVoxelMm;
+  write_number_attr(file, "voxel_size_mm", H5T_NATIVE_DOUBLE, &voxel);
+  write_string_dataset(file, "parameters", R"({"window":32})");
+  const hid_t sets = H5Gcreate2(file, "sets", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  for (const std::uint64_t index : {2u, 4u}) {
+    const SetResult r = set_with(index, static_cast<float>(index));
+    const std::string name = index == 2 ? "000002" : "000004";
+    const hid_t g = H5Gcreate2(sets, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    const double nodes[3] = {4, 3, 2}, origin[3] = {-1.0, -0.5, 0.25}, spacing[3] = {0.16, 0.16, 0.32};
+    write_number_attr(g, "nodes", H5T_NATIVE_DOUBLE, nodes, 3);
+    write_number_attr(g, "origin_mm", H5T_NATIVE_DOUBLE, origin, 3);
+    write_number_attr(g, "spacing_mm", H5T_NATIVE_DOUBLE, spacing, 3);
+    write_number_attr(g, "set_index", H5T_NATIVE_UINT64, &index);
+    write_number_attr(g, "dt_ns", H5T_NATIVE_INT64, &r.dt_ns);
+    write_number_attr(g, "seconds", H5T_NATIVE_DOUBLE, &r.seconds);
+    write_string_attr(g, "completed_utc", "2026-01-02T03:04:05Z");
+    write_array(g, "displacement_voxel", H5T_NATIVE_FLOAT, {2, 3, 4, 3}, r.field.displacement.data());
+    write_array(g, "status", H5T_NATIVE_UINT8, {2, 3, 4}, r.field.status.data());
+    write_array(g, "peak", H5T_NATIVE_FLOAT, {2, 3, 4}, r.field.peak.data());
+    write_string_dataset(g, "report", "{}");
+    const std::uint8_t complete = index == 2 ? 1 : 0;  // set 4 was never finished
+    write_number_attr(g, "complete", H5T_NATIVE_UINT8, &complete);
+    H5Gclose(g);
+  }
+  H5Gclose(sets);
+  H5Fclose(file);
+}
+
+TEST(ResultsFile, ReadsAndResumesVersion1AndRefusesNewerVersions) {
+  TempDir dir;
+  const auto old = dir / "v1.h5";
+  write_old_file(old, 1);
+  {
+    const ResultsReader r(old);
+    EXPECT_EQ(r.format_version(), 1);
+    ASSERT_EQ(r.set_indices(), std::vector<std::uint64_t>{2});  // set 4 has no completion marker
+    EXPECT_FLOAT_EQ(r.read_set(2).field.displacement[3].y, 4.0f);
+    EXPECT_EQ(r.read_set(2).completed_utc, "2026-01-02T03:04:05Z");
+  }
+  {  // resuming converts it once to version 2, keeping its set
+    ResultsWriter w(old, info());
+    EXPECT_EQ(w.resumed_sets(), 1u);
+    w.add(set_with(4, 1.0f));
+  }
+  const ResultsReader r(old);
+  EXPECT_EQ(r.format_version(), 2);
+  EXPECT_EQ(r.set_indices(), (std::vector<std::uint64_t>{2, 4}));
+  EXPECT_EQ(r.read_set(2).completed_utc, "2026-01-02T03:04:05Z");
+
+  const auto future = dir / "v3.h5";
+  write_old_file(future, 3);
+  try {
+    ResultsReader{future};
+    FAIL() << "a version-3 file was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::bad_input);
+    EXPECT_NE(std::string(e.what()).find("format version 3 is not supported"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

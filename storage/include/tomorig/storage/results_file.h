@@ -3,13 +3,16 @@
 // ensemble statistics, in HDF5 with an XDMF sidecar for ParaView. Layout in
 // docs/correlation.md ("Results file").
 //
-// Crash safety: ResultsWriter::add() writes the whole file to "<path>.partial", flushes it and
-// renames it over <path>. The file under the final name is therefore always complete and holds
-// every set finished so far, whatever happens afterwards (Ctrl-C, SIGKILL, a full disk). A run
-// that is started again with the same session and parameters skips the sets it finds.
+// Crash safety (format version 2): the file is created with its layout through "<path>.partial"
+// and a rename, then ResultsWriter::add() appends each set in place (HDF5 SWMR, one row of
+// growing datasets) and flushes; the set's completion byte is written and flushed last. So an
+// append costs O(set), and whatever happens (Ctrl-C, SIGKILL, a full disk) the file under the
+// final name opens and holds every set finished so far; a row without its completion byte is
+// ignored. A run started again with the same session and parameters skips the sets it finds.
 //
 //   ResultsWriter out("r.h5", {.session_path = "s.h5", .session_identity = id, ...});
 //   if (!out.has_set(7)) out.add({.set_index = 7, .dt_ns = 1000, .field = field});
+//   out.close();
 //   ResultsReader in("r.h5");  EnsembleStatistics s = in.statistics();
 #include <array>
 #include <cstdint>
@@ -56,6 +59,29 @@ struct EnsembleStatistics {
   static EnsembleStatistics compute(const std::vector<SetResult>& sets, double voxel_size_mm);
 };
 
+// The statistics of EnsembleStatistics, one set at a time (Welford's update: numerically as
+// safe as two passes, with O(nodes) memory whatever the number of sets).
+class EnsembleAccumulator {
+ public:
+  explicit EnsembleAccumulator(double voxel_size_mm) : voxel_size_mm_(voxel_size_mm) {}
+  // Throws tomorig::Error (bad_input) if the set's field has another shape than the first
+  // set's, its arrays do not match its nodes, or its dt is not > 0. Nothing changes then.
+  void check(const SetResult& set) const;
+  void add(const SetResult& set);  // check() first
+  std::uint64_t sets() const { return sets_; }
+  EnsembleStatistics result() const;
+
+ private:
+  double voxel_size_mm_;
+  std::uint64_t sets_ = 0;
+  std::uint64_t first_set_ = 0;
+  int nx_ = 0, ny_ = 0, nz_ = 0;
+  Vec3d origin_, spacing_;
+  std::vector<std::uint32_t> count_;
+  std::vector<Vec3d> mean_displacement_, mean_velocity_;
+  std::vector<std::array<double, 6>> comoment_;  // sums of u'u', v'v', w'w', u'v', u'w', v'w'
+};
+
 // Velocity (m/s) of a displacement of `voxels` over dt_ns nanoseconds.
 double velocity_m_per_s(double voxels, double voxel_size_mm, std::int64_t dt_ns);
 
@@ -65,24 +91,32 @@ struct ResultsWriterOptions {
 
 class ResultsWriter {
  public:
-  // A new file, or resumes an existing one: then its sets are loaded (has_set()) and kept.
-  // Throws tomorig::Error (bad_input) if the existing file is not a results file, belongs to
-  // another session (different identity) or was made with different parameters; or if the
-  // folder is missing or the path is a folder. Nothing is written before the first add().
+  // A new file, or resumes an existing one: then its finished sets are kept (has_set()) and
+  // the statistics rebuilt, reading one set at a time. Throws tomorig::Error (bad_input) if the
+  // existing file is not a results file, belongs to another session (different identity) or was
+  // made with different parameters; or if the folder is missing or the path is a folder.
+  // Nothing is written before write() or the first add(), except that a version-1 file is
+  // converted to version 2 at once; a file left by a killed writer is copied at the first add().
   ResultsWriter(const std::filesystem::path& path, const ResultsInfo& info, const ResultsWriterOptions& options = {});
   ~ResultsWriter();
   ResultsWriter(const ResultsWriter&) = delete;
   ResultsWriter& operator=(const ResultsWriter&) = delete;
 
   bool has_set(std::uint64_t set_index) const;
-  const std::vector<SetResult>& sets() const;  // in the order added (resumed ones first)
-  std::uint64_t resumed_sets() const;          // sets found in the existing file
-  // Adds a finished set and rewrites the file (statistics and XDMF sidecar included),
-  // atomically. Throws bad_input for a set already present, a field of another shape or dt <= 0;
-  // runtime (file left as it was, the set not added) if writing fails, e.g. a full disk.
-  void add(SetResult set);
-  // Rewrites the file with what it holds (e.g. to create an empty results file).
+  std::uint64_t set_count() const;                  // sets in the file (resumed ones included)
+  std::vector<std::uint64_t> set_indices() const;   // ascending
+  std::uint64_t resumed_sets() const;               // sets found in the existing file
+  EnsembleStatistics statistics() const;            // over every set in the file
+  // Appends a finished set in place (O(set): earlier sets are not rewritten) and updates the
+  // statistics; the XDMF sidecar follows at most every few seconds and at close(). Throws
+  // bad_input for a set already present, a field of another shape or dt <= 0; runtime if
+  // writing fails, e.g. a full disk: the set is not added, the file keeps every earlier set,
+  // and a later add() reopens it.
+  void add(const SetResult& set);
+  // Creates the file now if it does not exist yet (an empty, valid results file).
   void write();
+  // Flushes, writes the sidecar and closes the file (the destructor does the same, silently).
+  void close();
 
   const std::filesystem::path& path() const;
   static std::filesystem::path sidecar_path(const std::filesystem::path& results_file);
@@ -99,11 +133,13 @@ class ResultsReader {
   ~ResultsReader();
 
   const ResultsInfo& info() const;
+  int format_version() const;                      // 1 (one group per set) or 2 (rows)
   std::vector<std::uint64_t> set_indices() const;  // ascending
   SetResult read_set(std::uint64_t set_index) const;  // bad_input if absent
-  std::vector<SetResult> read_all_sets() const;
+  std::vector<SetResult> read_all_sets() const;     // all in memory: prefer read_set in a loop
   bool has_statistics() const;                        // false with no set
-  EnsembleStatistics statistics() const;              // bad_input if none
+  // Recomputed from the sets, reading one at a time. bad_input if there is no set.
+  EnsembleStatistics statistics() const;
 
  private:
   struct Impl;
