@@ -35,7 +35,8 @@ struct RaceArgs {
   double fmart_relaxation = 1.0;
   double smart_relaxation = 1.5;
   double mlos_threshold = 0.05;
-  double prune_fraction = 1e-4;  // < 0: the library default (no pruning)
+  double prune_fraction = -1.0;  // < 0: the library default
+  double sigma_px = 0.0;         // weight sigma, all cameras; 0: the library default
   double q_target = 0.0;         // 0: the lower of the two algorithms' best Q, per density
   std::string smoothing = "0.68,0.68,0.1";
   std::string grid;
@@ -203,6 +204,7 @@ void run(const RaceArgs& args) {
       input.sensor_sizes.push_back({rig.cameras()[c].spec.width, rig.cameras()[c].spec.height});
     }
     input.grid = grid;
+    if (args.sigma_px > 0) input.psf.assign(input.cameras.size(), recon::PsfModel::constant(args.sigma_px));
     const quality::QualityEvaluator judge(grid, set.particles_a);
 
     const Run fmart = race_one("fmart", args.fmart_iterations, args.fmart_relaxation, args, input, judge, smoothing);
@@ -235,6 +237,7 @@ void run(const RaceArgs& args) {
       {"seed", args.seed},
       {"mlos_threshold", args.mlos_threshold},
       {"prune_fraction", args.prune_fraction >= 0 ? args.prune_fraction : recon::ReconstructionOptions{}.prune_fraction},
+      {"sigma_px", args.sigma_px > 0 ? nlohmann::json(args.sigma_px) : nlohmann::json("default")},
       {"smoothing_sigma_voxel", nlohmann::json{smoothing.x, smoothing.y, smoothing.z}},
       {"q", "windowed Q (Eq. 3.14, 64^3 windows) of the smoothed volume; time excludes the judging"},
       {"machine", machine_json()},
@@ -259,6 +262,10 @@ void add_bench_recon_race_command(CLI::App& bench) {
   cmd->add_option("--prune", args->prune_fraction,
                   "Drop voxels below this fraction of the largest intensity after each iteration, both "
                   "algorithms (0: never; negative: the library default)")
+      ->capture_default_str();
+  cmd->add_option("--sigma-px", args->sigma_px,
+                  "Gaussian sigma of the voxel-to-pixel weights, pixels, all cameras (0: the library default)")
+      ->check(CLI::Range(0.0, 10.0))
       ->capture_default_str();
   cmd->add_option("--q-target", args->q_target,
                   "Windowed Q both must reach (0: the lower of the two algorithms' best Q at each density)")
