@@ -42,6 +42,7 @@ struct BenchPiv3dArgs {
   std::uint64_t seed = 1;
   int threads = 0;
   std::string json_out;
+  std::string errors_csv;
 };
 
 // The grid of --reduced: 128 x 128 voxels at the centre of the case grid, its full depth and
@@ -112,6 +113,26 @@ FieldError judge(const VectorField& f, const sim::Flow& flow, double voxel_size)
   e.valid_fraction = interior > 0 ? static_cast<double>(valid) / interior : 0.0;
   e.nodes = interior;
   return e;
+}
+
+// One line per node (all layers): index, position (voxel), measured and true displacement,
+// status, peak; for looking at where the error sits.
+void write_errors_csv(const std::string& path, const std::string& source, double ppp, const VectorField& f,
+                      const sim::Flow& flow, const VoxelGrid& grid) {
+  std::FILE* out = std::fopen(path.c_str(), "a");
+  if (!out) throw runtime_error(fmt::format("cannot open --errors-csv '{}' for appending", path));
+  for (int k = 0; k < f.nz; ++k)
+    for (int j = 0; j < f.ny; ++j)
+      for (int i = 0; i < f.nx; ++i) {
+        const std::size_t n = f.linear(i, j, k);
+        const Vec3d x{f.origin.x + i * f.spacing.x, f.origin.y + j * f.spacing.y, f.origin.z + k * f.spacing.z};
+        const Vec3d v = grid.voxel_of(x);
+        const Vec3d t = flow.displacement(x) * (1.0 / grid.voxel_size);
+        const Vec3f& d = f.displacement[n];
+        fmt::print(out, "{},{},{},{},{},{},{:.3f},{:.3f},{:.3f},{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{},{:.4f}\n", source,
+                   ppp, i, j, k, f.nx, v.x, v.y, v.z, d.x, d.y, d.z, t.x, t.y, t.z, static_cast<int>(f.status[n]), f.peak[n]);
+      }
+  std::fclose(out);
 }
 
 void run(const BenchPiv3dArgs& args) {
@@ -193,6 +214,7 @@ void run(const BenchPiv3dArgs& args) {
       const VectorField field = piv::correlate(a, b, options, report);
       const double total = std::chrono::duration<double>(Clock::now() - start).count();
       const FieldError e = judge(field, rig.flow(), grid.voxel_size);
+      if (!args.errors_csv.empty()) write_errors_csv(args.errors_csv, source, ppp, field, rig.flow(), grid);
       fmt::print(stderr, "  {:6} RMS {:.3f} voxel (x {:.3f}, y {:.3f}, z {:.3f}), {:.1f} % valid, correlation {:.1f} s, "
                          "total {:.1f} s\n",
                  source, e.rms_magnitude, e.rms.x, e.rms.y, e.rms.z, 100.0 * e.valid_fraction, report.seconds_total,
@@ -249,6 +271,9 @@ void add_bench_piv3d_command(CLI::App& bench) {
       ->capture_default_str();
   cmd->add_option("--seed", args->seed, "Random seed of the particle field")->capture_default_str();
   cmd->add_option("--threads", args->threads, "OpenMP threads (0: all cores)")->capture_default_str();
+  cmd->add_option("--errors-csv", args->errors_csv,
+                  "Append one CSV line per node (source, ppp, i, j, k, nx, position, measured and true displacement "
+                  "in voxel, status, peak) to this file");
   cmd->add_option("--json", args->json_out, "Write the JSON here ('-' or empty: stdout)");
   cmd->callback([args] { run(*args); });
 }

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/core.h>
@@ -65,8 +66,14 @@ CorrelationOptions CorrelationOptions::multigrid(WindowSize final_window, double
   options.passes.push_back(coarse);
   CorrelationPass offset;
   offset.window = final_window;
-  offset.overlap = overlap;
+  // When deformation passes follow, the integer-offset pass only feeds them, at most at 50 %
+  // overlap: its vectors carry the gradient bias of undeformed windows, and at 75 % that
+  // error varies from node to node on scales finer than a window, which no later window can
+  // correct (reduced tpiv-thesis truth volumes: 0.097 voxel against 0.067 with 50 %; and 8x
+  // fewer windows to correlate).
+  offset.overlap = deformation_passes > 0 ? std::min(overlap, 0.5) : overlap;
   options.passes.push_back(offset);
+  offset.overlap = overlap;
   for (int n = 0; n < deformation_passes; ++n) {
     CorrelationPass deform = offset;
     deform.deformation = true;

@@ -1,5 +1,7 @@
 #include "correlation/volume_deformation.h"
 
+#include "correlation/flush_denormals.h"
+
 #include <omp.h>
 
 #include <algorithm>
@@ -24,6 +26,47 @@ void prefilter_line(float* c, int n) {
   for (int k = 1; k < n; ++k) c[k] = static_cast<float>(c[k] + pole * c[k - 1]);
   c[n - 1] = static_cast<float>(pole / (pole * pole - 1.0) * (c[n - 1] + pole * c[n - 2]));
   for (int k = n - 2; k >= 0; --k) c[k] = static_cast<float>(pole * (c[k + 1] - c[k]));
+}
+
+// prefilter_line on `width` lines at once: element k of every line is the contiguous row
+// base[k * stride .. k * stride + width).
+void prefilter_rows(float* base, std::size_t stride, int n, int width) {
+  if (n < 2) return;
+  constexpr float pole = -0.2679491924311228f;
+  constexpr float gain = 6.0f;
+  auto row = [&](int k) { return base + static_cast<std::size_t>(k) * stride; };
+  for (int k = 0; k < n; ++k) {
+    float* r = row(k);
+#pragma omp simd
+    for (int x = 0; x < width; ++x) r[x] *= gain;
+  }
+  const int horizon = std::min(n, 30);
+  float zk = pole;
+  for (int k = 1; k < horizon; ++k, zk *= pole) {
+    float* r0 = row(0);
+    const float* r = row(k);
+#pragma omp simd
+    for (int x = 0; x < width; ++x) r0[x] += zk * r[x];
+  }
+  for (int k = 1; k < n; ++k) {
+    float* r = row(k);
+    const float* p = row(k - 1);
+#pragma omp simd
+    for (int x = 0; x < width; ++x) r[x] += pole * p[x];
+  }
+  {
+    float* r = row(n - 1);
+    const float* p = row(n - 2);
+    constexpr float end_gain = pole / (pole * pole - 1.0f);
+#pragma omp simd
+    for (int x = 0; x < width; ++x) r[x] = end_gain * (r[x] + pole * p[x]);
+  }
+  for (int k = n - 2; k >= 0; --k) {
+    float* r = row(k);
+    const float* next = row(k + 1);
+#pragma omp simd
+    for (int x = 0; x < width; ++x) r[x] = pole * (next[x] - r[x]);
+  }
 }
 
 float sample_trilinear(const VolumeView& v, float x, float y, float z) {
@@ -119,37 +162,31 @@ std::vector<float> downsample_sum(const VolumeView& v, int factor, int threads) 
 
 void bspline_prefilter(std::vector<float>& values, int nx, int ny, int nz, int threads) {
   const int t = thread_count(threads);
-  const std::size_t sx = 1, sy = nx, sz = static_cast<std::size_t>(nx) * ny;
+  const std::size_t sy = nx, sz = static_cast<std::size_t>(nx) * ny;
 #pragma omp parallel num_threads(t)
   {
-    std::vector<float> line(std::max({nx, ny, nz}));
+    const FlushDenormals flush;
+    // x: contiguous lines, one at a time.
 #pragma omp for schedule(static)
     for (int k = 0; k < nz; ++k)
       for (int j = 0; j < ny; ++j) prefilter_line(values.data() + j * sy + k * sz, nx);
+    // y and z: all lines of a slice (or of an x-z sheet) advance together, row by row, so the
+    // inner loop runs over contiguous x (vectorised, no strided gathers).
 #pragma omp for schedule(static)
-    for (int k = 0; k < nz; ++k)
-      for (int i = 0; i < nx; ++i) {
-        float* base = values.data() + i * sx + k * sz;
-        for (int j = 0; j < ny; ++j) line[j] = base[j * sy];
-        prefilter_line(line.data(), ny);
-        for (int j = 0; j < ny; ++j) base[j * sy] = line[j];
-      }
+    for (int k = 0; k < nz; ++k) prefilter_rows(values.data() + k * sz, sy, ny, nx);
 #pragma omp for schedule(static)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) {
-        float* base = values.data() + i * sx + j * sy;
-        for (int k = 0; k < nz; ++k) line[k] = base[k * sz];
-        prefilter_line(line.data(), nz);
-        for (int k = 0; k < nz; ++k) base[k * sz] = line[k];
-      }
+    for (int j = 0; j < ny; ++j) prefilter_rows(values.data() + j * sy, sz, nz, nx);
   }
 }
 
 Vec3f sample_field(const VectorField& f, double x, double y, double z) {
   auto locate = [](double p, double origin, double spacing, int n, int& i0, double& frac) {
     double u = spacing > 0 ? (p - origin) / spacing : 0.0;
-    u = std::clamp(u, 0.0, static_cast<double>(n - 1));
-    i0 = std::min(static_cast<int>(u), std::max(n - 2, 0));
+    // Beyond the outermost nodes: linear extrapolation of the end cell, for at most one node
+    // spacing (the outermost half window). A constant there (the old rule) deforms the
+    // boundary windows with the wrong gradient and biased the next-to-boundary nodes.
+    u = std::clamp(u, -1.0, static_cast<double>(n));
+    i0 = std::clamp(static_cast<int>(std::floor(u)), 0, std::max(n - 2, 0));
     frac = n > 1 ? u - i0 : 0.0;
   };
   int i, j, k;
@@ -160,13 +197,13 @@ Vec3f sample_field(const VectorField& f, double x, double y, double z) {
   double r[3] = {0, 0, 0};
   for (int dk = 0; dk <= 1; ++dk) {
     const double wz = dk ? fz : 1.0 - fz;
-    if (wz == 0.0) continue;
+    if (wz == 0.0 || (f.nz == 1 && dk)) continue;
     for (int dj = 0; dj <= 1; ++dj) {
       const double wy = dj ? fy : 1.0 - fy;
-      if (wy == 0.0) continue;
+      if (wy == 0.0 || (f.ny == 1 && dj)) continue;
       for (int di = 0; di <= 1; ++di) {
         const double w = wz * wy * (di ? fx : 1.0 - fx);
-        if (w == 0.0) continue;
+        if (w == 0.0 || (f.nx == 1 && di)) continue;
         const Vec3f& d = f.displacement[f.linear(i + di, j + dj, k + dk)];
         r[0] += w * d.x;
         r[1] += w * d.y;
@@ -179,11 +216,15 @@ Vec3f sample_field(const VectorField& f, double x, double y, double z) {
 
 void deform_pair(const VolumeView& a, const VolumeView& b, const VectorField& predictor, int factor,
                  Interpolation interpolation, std::vector<float>& out_a, std::vector<float>& out_b, int threads) {
-  out_a.assign(a.count(), 0.0f);
-  out_b.assign(b.count(), 0.0f);
+  // Every voxel is written below: size the (reused) buffers without clearing them first.
+  out_a.resize(a.count());
+  out_b.resize(b.count());
   const double offset = 0.5 * (factor - 1);  // full-grid position of a binned voxel's centre
   const float half = 0.5f / factor;           // half the displacement, in binned voxels
-#pragma omp parallel for num_threads(thread_count(threads)) schedule(dynamic, 1)
+#pragma omp parallel num_threads(thread_count(threads))
+  {
+  const FlushDenormals flush;
+#pragma omp for schedule(dynamic, 1)
   for (int k = 0; k < a.nz; ++k)
     for (int j = 0; j < a.ny; ++j) {
       const std::size_t row = a.linear(0, j, k);
@@ -199,6 +240,7 @@ void deform_pair(const VolumeView& a, const VolumeView& b, const VectorField& pr
         }
       }
     }
+  }
 }
 
 }  // namespace tomorig::piv::detail

@@ -24,8 +24,8 @@ void bspline_prefilter(std::vector<float>& values, int nx, int ny, int nz, int t
 void deform_pair(const VolumeView& a, const VolumeView& b, const VectorField& predictor, int factor,
                  Interpolation interpolation, std::vector<float>& out_a, std::vector<float>& out_b, int threads);
 
-// The predictor at a full-grid voxel position: trilinear between nodes, constant beyond the
-// outermost nodes.
+// The predictor at a full-grid voxel position: trilinear between nodes, linearly extrapolated
+// from the end cell up to one node spacing beyond the outermost nodes, constant further out.
 Vec3f sample_field(const VectorField& field, double x, double y, double z);
 
 }  // namespace tomorig::piv::detail

@@ -48,8 +48,10 @@ struct CorrelationOptions {
   // larger than `grid`.
   void validate(const VoxelGrid& grid) const;
 
-  // The thesis's scheme: one pass at twice the final window on volumes binned 2x, one at the
-  // final window with integer offset, then `deformation_passes` deformation passes.
+  // The thesis's scheme: one pass at twice the final window on volumes binned 2x (50 %
+  // overlap), one at the final window with integer offset (at most 50 % overlap when
+  // deformation passes follow, else `overlap`), then `deformation_passes` deformation passes
+  // at `overlap`.
   static CorrelationOptions multigrid(WindowSize final_window, double overlap, int deformation_passes,
                                       Interpolation interpolation = Interpolation::cubic_bspline);
 };
