@@ -38,6 +38,7 @@ struct BenchPiv3dArgs {
   double particles_per_window = 10.0;
   CorrelationArgs correlation;
   int iterations = 0;
+  double sigma_px = 0.0;  // reconstruction weight sigma, all cameras; 0: the library default
   std::string fmart_smoothing = "0.68,0.68,0.1";
   std::uint64_t seed = 1;
   int threads = 0;
@@ -199,6 +200,7 @@ void run(const BenchPiv3dArgs& args) {
           input.sensor_sizes.push_back({rig.cameras()[c].spec.width, rig.cameras()[c].spec.height});
         }
         input.grid = grid;
+        if (args.sigma_px > 0) input.psf.assign(input.cameras.size(), recon::PsfModel::constant(args.sigma_px));
         const bool smooth = source == "fmart" && (smoothing.x > 0 || smoothing.y > 0 || smoothing.z > 0);
         for (const Exposure e : {Exposure::A, Exposure::B}) {
           input.images.clear();
@@ -242,6 +244,7 @@ void run(const BenchPiv3dArgs& args) {
                               {"deformation_passes", shown.deformation_passes},
                               {"weighting", shown.weighting},
                               {"fmart_smoothing", args.fmart_smoothing},
+                              {"sigma_px", args.sigma_px > 0 ? nlohmann::json(args.sigma_px) : nlohmann::json("default")},
                               {"seed", args.seed},
                               {"boundary_nodes_excluded", 1},
                               {"machine", machine_json()},
@@ -266,6 +269,10 @@ void add_bench_piv3d_command(CLI::App& bench) {
   cmd->add_option("--particles-per-window", args->particles_per_window, "Target of --window auto")
       ->capture_default_str();
   cmd->add_option("--iterations", args->iterations, "Reconstruction iterations (0: the algorithm's default)");
+  cmd->add_option("--sigma-px", args->sigma_px,
+                  "Reconstruction weight sigma, pixels, all cameras (0: the library default)")
+      ->check(CLI::Range(0.0, 10.0))
+      ->capture_default_str();
   cmd->add_option("--fmart-smoothing", args->fmart_smoothing,
                   "Gaussian sigma x,y,z (voxel) applied to FMART volumes before correlation, as the thesis did; 0: none")
       ->capture_default_str();
