@@ -197,4 +197,37 @@ void GridProjector::row_at(std::size_t c, int j, int k, const int* voxels, int c
   }
 }
 
+int GridProjector::max_segments() const {
+  int most = 1;
+  for (const Lattice& l : cams_) most = std::max(most, l.nodes_x);  // one spare: the last node
+  return most;
+}
+
+int GridProjector::row_segments(std::size_t c, int j, int k, float* u0, float* du, float* v0, float* dv) const {
+  const Lattice& l = cams_[c];
+  if (l.step == 1) return 0;
+  const int s = l.step;
+  const int cb = std::min(j / s, l.nodes_y - 2), cc = std::min(k / s, l.nodes_z - 2);
+  const float fb = static_cast<float>(j - cb * s) / s, fc = static_cast<float>(k - cc * s) / s;
+  const float w00 = (1 - fb) * (1 - fc), w10 = fb * (1 - fc), w01 = (1 - fb) * fc, w11 = fb * fc;
+  const std::size_t plane = static_cast<std::size_t>(l.nodes_x) * l.nodes_y;
+  const std::size_t r00 = static_cast<std::size_t>(l.nodes_x) * cb + plane * cc;
+  const std::size_t r10 = r00 + l.nodes_x, r01 = r00 + plane, r11 = r00 + plane + l.nodes_x;
+  const float* pu = l.u.data();
+  const float* pv = l.v.data();
+  // The nodes as row() computes them (a loop without a carried value, so it vectorises) ...
+  for (int a = 0; a < l.nodes_x; ++a) {
+    u0[a] = w00 * pu[r00 + a] + w10 * pu[r10 + a] + w01 * pu[r01 + a] + w11 * pu[r11 + a];
+    v0[a] = w00 * pv[r00 + a] + w10 * pv[r10 + a] + w01 * pv[r01 + a] + w11 * pv[r11 + a];
+  }
+  // ... and the slopes. The step is a power of two, so multiplying by its inverse is exact:
+  // the same bits as row()'s division.
+  const float inverse = 1.0f / static_cast<float>(s);
+  for (int a = 0; a + 1 < l.nodes_x; ++a) {
+    du[a] = (u0[a + 1] - u0[a]) * inverse;
+    dv[a] = (v0[a + 1] - v0[a]) * inverse;
+  }
+  return l.nodes_x - 1;
+}
+
 }  // namespace tomorig::recon::detail

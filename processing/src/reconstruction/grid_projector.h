@@ -26,6 +26,15 @@ class GridProjector {
   // k), written to u[i], v[i]: what row() gives there, without filling the whole row.
   void row_at(std::size_t c, int j, int k, const int* voxels, int count, float* u, float* v) const;
 
+  // The linear segments of row (j, k) in camera c, for kernels that compute positions
+  // themselves: voxel i of segment a, i in [a * step, a * step + length), is at
+  // u = u0[a] + du[a] * (i - a * step), v likewise -- the arithmetic of row(), so the positions
+  // are the same to the bit. The last segment ends at nx. Each array needs max_segments()
+  // entries (u0 and v0 also receive the row's last node). Returns the number of segments; 0
+  // for exact projection (step 1).
+  int row_segments(std::size_t c, int j, int k, float* u0, float* du, float* v0, float* dv) const;
+  int max_segments() const;
+
   // Lattice step used for camera c; 1 means exact projection of every voxel.
   int step(std::size_t c) const { return cams_[c].step; }
   // Largest interpolation error found at the cell centres, pixels (0 for exact projection).

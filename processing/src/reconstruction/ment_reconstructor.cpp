@@ -34,6 +34,7 @@
 #include "grid_projector.h"
 #include "ment.h"
 #include "ment_samples.h"
+#include "support_scan.h"
 #include "prepared_input.h"
 #include "support.h"
 #include "system_memory.h"
@@ -47,6 +48,7 @@ namespace {
 // factor. The thesis sampled at half the voxel depth (dz_1 = 0.5 dz_2); one sample per voxel
 // gave the same Q on tpiv-thesis at 0.05 ppp (0.800 against 0.796 with two, 4 iterations; the
 // residuals agree to 1e-3) at half the samples, time and memory, so one it is.
+// The sample list holds voxel centres only (ment_samples.h).
 constexpr int kSubsteps = 1;
 
 struct PlaneRef {
@@ -92,9 +94,9 @@ class MentReconstructor final : public Reconstructor {
     const double budget = check_memory(report);
     const GridProjector projector(in_);
     make_planes();
+    samples_ = build_ment_samples(in_, projector, measured_, codec_, options_.mlos_threshold, budget);
     // The normalised images are now in measured_; the float copies are not needed any more.
     for (CameraImage& im : in_.images) im.pixels = {};
-    samples_ = build_ment_samples(in_, projector, measured_, order_, codec_, kSubsteps, budget);
     report.setup_seconds = seconds_since(start);
 
     for (int it = 1; it <= options_.max_iterations; ++it) {
@@ -256,8 +258,8 @@ class MentReconstructor final : public Reconstructor {
     return out;
   }
 
-  // Eq. 3.4: E = product of the pseudo-images at the voxel's image positions, slice by slice in
-  // z order, appended straight to the sparse output. Only voxel-centre samples can be non-zero.
+  // Eq. 3.4: E = product of the pseudo-images at the voxel's image positions, block of slices by
+  // block in z order, appended straight to the sparse output. Only voxel-centre samples can be non-zero.
   SparseVolume recover_volume(ReconstructionReport& report) {
     const VoxelGrid& g = in_.grid;
     const std::size_t cams = in_.camera_count();
@@ -279,13 +281,18 @@ class MentReconstructor final : public Reconstructor {
     std::vector<PlaneRef> planes;
     for (std::size_t c : order_) planes.push_back({pseudo_[c].data.data(), static_cast<std::size_t>(pseudo_[c].stride), c});
 
+    // Slabs hold blocks of slices in (j, k, i) order; the output wants ascending indices, i.e.
+    // (k, j, i): each slab's voxels are bucketed by slice (a stable counting sort).
+    const std::uint32_t plane = static_cast<std::uint32_t>(g.nx) * static_cast<std::uint32_t>(g.ny);
+    const int slabs = static_cast<int>(samples_.slabs.size());
 #pragma omp parallel num_threads(in_.threads)
     {
-      std::vector<std::uint32_t> index;
-      std::vector<float> value;
+      std::vector<std::uint32_t> index, sorted_index;
+      std::vector<float> value, sorted_value;
+      std::vector<std::size_t> start;
 #pragma omp for ordered schedule(static, 1)
-      for (int k = 0; k < g.nz; ++k) {
-        const MentSlab& slab = samples_.slabs[static_cast<std::size_t>(k)];
+      for (int b = 0; b < slabs; ++b) {
+        const MentSlab& slab = samples_.slabs[static_cast<std::size_t>(b)];
         index.clear();
         value.clear();
         const std::uint32_t* code = slab.code.data();
@@ -297,11 +304,22 @@ class MentReconstructor final : public Reconstructor {
             value.push_back(product);
           }
         }
+        const std::uint32_t k0 = static_cast<std::uint32_t>(b * kSlabSlices);
+        start.assign(kSlabSlices + 1, 0);
+        for (std::uint32_t at : index) ++start[at / plane - k0 + 1];
+        for (int q = 0; q < kSlabSlices; ++q) start[q + 1] += start[q];
+        sorted_index.resize(index.size());
+        sorted_value.resize(value.size());
+        for (std::size_t n = 0; n < index.size(); ++n) {
+          const std::size_t to = start[index[n] / plane - k0]++;
+          sorted_index[to] = index[n];
+          sorted_value[to] = value[n];
+        }
 #pragma omp ordered
         {
-          if (!over_budget && static_cast<double>(volume.size() + index.size()) <= budget) {
-            volume.index.insert(volume.index.end(), index.begin(), index.end());
-            volume.intensity.insert(volume.intensity.end(), value.begin(), value.end());
+          if (!over_budget && static_cast<double>(volume.size() + sorted_index.size()) <= budget) {
+            volume.index.insert(volume.index.end(), sorted_index.begin(), sorted_index.end());
+            volume.intensity.insert(volume.intensity.end(), sorted_value.begin(), sorted_value.end());
           } else {
             over_budget = true;
           }

@@ -1,10 +1,10 @@
 #pragma once
-// The sparse sample list of MENT (thesis Sect. 3.1.1): the points of the grid lattice, refined
-// to 1/substeps of a voxel in z, that project next to a non-empty pixel of every camera. Only
+// The sparse sample list of MENT (thesis Sect. 3.1.1): the voxel centres (one line-of-sight
+// sample per voxel depth) that read > 0 in every camera, i.e. the MLOS support. Only
 // these points can carry a non-zero product of pseudo-images (h_j is 0 where the thresholded
 // image p_j is, Eq. 3.1), so MENT's sweeps visit them and nothing else. They are found once, by
-// an MLOS-like pass, and kept per z-slice with their image position in every camera packed into
-// 32 bits (see CellCode). It is a sparse list of the support, not a volume.
+// the MLOS support pass, and kept per block of z-slices with their image position in every
+// camera packed into 32 bits (see CellCode). It is a sparse list of the support, not a volume.
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -92,8 +92,10 @@ class CellCode {
   float steps_ = 256.0f, step_ = 1.0f / 256, half_step_ = 0.5f / 256;
 };
 
-// The samples of one z-slice k: voxel centres (depth k) first, then the samples between k and
-// k + 1 (depth k + s / substeps). Codes are sample-major: code[n * cameras + c].
+// The samples of one block of kSlabSlices z-slices (support_scan.h), all voxel centres
+// (`centres` of them; the count is kept so that samples between slices could follow them), in
+// (j, k, i) order: by grid row, then slice, then x. Codes are sample-major:
+// code[n * cameras + c].
 struct MentSlab {
   std::uint32_t centres = 0;
   std::vector<std::uint32_t> code;
@@ -101,21 +103,20 @@ struct MentSlab {
 };
 
 struct MentSamples {
-  std::vector<MentSlab> slabs;  // one per z-slice
+  std::vector<MentSlab> slabs;  // one per block of kSlabSlices z-slices
   std::size_t samples = 0, centres = 0;
-  int substeps = 2;
 };
 
 // Bytes the sample list holds per sample and per voxel-centre sample (for memory estimates).
 double ment_bytes_per_sample(std::size_t cameras);
 constexpr double kMentBytesPerCentre = 4.0;
 
-// The MLOS-like pass: every lattice point (i, j, k + s / substeps) whose bilinear read of
-// `measured` (the thresholded images, zero-bordered) is > 0 in every camera, cameras tried in
-// `order` (most selective first); z-slices in parallel. Throws tomorig::Error (bad_input) as
-// soon as the list outgrows `budget_bytes`.
+// The MLOS support pass (support_scan.h): every voxel centre whose bilinear read of `measured`
+// (the images thresholded at `threshold` x their maximum, zero-bordered) is > 0 in every
+// camera, also at its quantised position; z-slices in parallel. Throws tomorig::Error
+// (bad_input) as soon as the list outgrows `budget_bytes`.
 MentSamples build_ment_samples(const PreparedInput& in, const GridProjector& projector,
-                               const std::vector<MentPlane>& measured, const std::vector<std::size_t>& order,
-                               const CellCode& codec, int substeps, double budget_bytes);
+                               const std::vector<MentPlane>& measured, const CellCode& codec, double threshold,
+                               double budget_bytes);
 
 }  // namespace tomorig::recon::detail

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdio>
 #include <cmath>
 #include <exception>
 #include <numeric>
@@ -9,70 +10,13 @@
 
 #include <fmt/core.h>
 
+#include "stage_timer.h"
+#include "support_scan.h"
 #include "system_memory.h"
 #include "tomorig/core/error.h"
 
 namespace tomorig::recon::detail {
 namespace {
-
-// A thresholded copy of an image with a one-pixel border of zeros, so that bilinear sampling
-// anywhere inside the image span [-0.5, W - 0.5] needs no bounds checks.
-struct SampledImage {
-  int width = 0, height = 0, stride = 0;
-  std::vector<float> pixels;
-  double nonzero_fraction = 0.0;
-
-  SampledImage(const CameraImage& image, double threshold) : width(image.width), height(image.height) {
-    stride = width + 2;
-    pixels.assign(static_cast<std::size_t>(stride) * (height + 2), 0.0f);
-    const float cut = static_cast<float>(threshold) * image.max;
-    std::size_t nonzero = 0;
-    for (int y = 0; y < height; ++y)
-      for (int x = 0; x < width; ++x) {
-        const float v = image.at(x, y);
-        if (v > 0 && v >= cut) {
-          pixels[static_cast<std::size_t>(y + 1) * stride + x + 1] = v;
-          ++nonzero;
-        }
-      }
-    nonzero_fraction = static_cast<double>(nonzero) / (static_cast<double>(width) * height);
-  }
-
-  // reach[y * stride + x] != 0 iff one of the four pixels a bilinear sample with
-  // x = floor(u + 1), y = floor(v + 1) reads is non-empty: one byte decides most voxels.
-  std::vector<std::uint8_t> reach;
-  double reach_fraction = 0.0;
-
-  void build_reach() {
-    reach.assign(pixels.size(), 0);
-    std::size_t count = 0;
-    for (int y = 0; y <= height; ++y)
-      for (int x = 0; x <= width; ++x) {
-        const float* p = pixels.data() + static_cast<std::size_t>(y) * stride + x;
-        const bool any = p[0] > 0 || p[1] > 0 || p[stride] > 0 || p[stride + 1] > 0;
-        reach[static_cast<std::size_t>(y) * stride + x] = any;
-        count += any;
-      }
-    reach_fraction = static_cast<double>(count) / (static_cast<double>(width + 1) * (height + 1));
-  }
-
-  // Whether (u, v) lies inside the image span and next to a non-empty pixel.
-  bool reaches(float u, float v) const {
-    const bool in = u >= -0.5f && u <= width - 0.5f && v >= -0.5f && v <= height - 0.5f;
-    const int x = in ? static_cast<int>(u + 1.0f) : 0, y = in ? static_cast<int>(v + 1.0f) : 0;
-    return in && reach[static_cast<std::size_t>(y) * stride + x] != 0;
-  }
-
-  // Bilinear interpolation at (u, v) known to be inside the image span.
-  float sample_inside(float u, float v) const {
-    const int x = static_cast<int>(u + 1.0f), y = static_cast<int>(v + 1.0f);
-    const float ax = u + 1.0f - static_cast<float>(x), ay = v + 1.0f - static_cast<float>(y);
-    const float* p = pixels.data() + static_cast<std::size_t>(y) * stride + x;
-    const float top = p[0] + ax * (p[1] - p[0]);
-    const float bottom = p[stride] + ax * (p[stride + 1] - p[stride]);
-    return top + ay * (bottom - top);
-  }
-};
 
 struct SliceResult {
   std::vector<std::uint32_t> index;
@@ -83,18 +27,8 @@ struct SliceResult {
 
 ActiveSet run_mlos(const PreparedInput& in, const GridProjector& projector, const MlosSettings& settings) {
   const VoxelGrid& g = in.grid;
-  const std::size_t cams = in.camera_count();
-  std::vector<SampledImage> images;
-  for (const CameraImage& image : in.images) {
-    images.emplace_back(image, settings.threshold);
-    images.back().build_reach();
-  }
-  // The most selective camera first: most voxels then stop after one lookup.
-  std::vector<std::size_t> order(cams);
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return images[a].reach_fraction < images[b].reach_fraction;
-  });
+  // Thresholded images, reach masks, cameras ordered most selective first (support_scan.h).
+  const SupportScanner scanner(in, projector, settings.threshold);
 
   const double limit_mb = settings.memory_limit_mb > 0 ? settings.memory_limit_mb : usable_memory_mb();
   const double budget_voxels =
@@ -105,64 +39,41 @@ ActiveSet run_mlos(const PreparedInput& in, const GridProjector& projector, cons
   std::atomic<bool> over_budget{false};
 
   std::vector<SliceResult> slices(static_cast<std::size_t>(g.nz));
+  // Blocks of kSlabSlices z-slices, row by row across the block: the same grid row j of
+  // neighbouring slices projects to the same few image rows, so their reads hit the cache.
+  const int blocks = (g.nz + kSlabSlices - 1) / kSlabSlices;
 #pragma omp parallel num_threads(in.threads)
   {
-    std::vector<float> u(static_cast<std::size_t>(g.nx) * cams), v(static_cast<std::size_t>(g.nx) * cams);
-    std::vector<float> product(static_cast<std::size_t>(g.nx));
-    std::vector<int> alive(static_cast<std::size_t>(g.nx));
+    SupportScanner::Row row = scanner.make_row();
 #pragma omp for schedule(dynamic, 1)
-    for (int k = 0; k < g.nz; ++k) {
+    for (int b = 0; b < blocks; ++b) {
       if (over_budget.load(std::memory_order_relaxed)) continue;
-      SliceResult& out = slices[static_cast<std::size_t>(k)];
-      for (int j = 0; j < g.ny; ++j) {
-        // First camera: the whole row's positions (a linear fill), one byte of the reach mask
-        // per voxel, and the bilinear sample only where it can be non-zero. Later cameras:
-        // positions and samples of the surviving voxels only.
-        int count = 0;
-        {
-          const std::size_t c = order[0];
-          float* uc = u.data() + c * g.nx;
-          float* vc = v.data() + c * g.nx;
-          projector.row(c, j, k, uc, vc);
-          const SampledImage& image = images[c];
-          for (int i = 0; i < g.nx; ++i) {
-            alive[count] = i;
-            count += image.reaches(uc[i], vc[i]);
-          }
-          int kept = 0;
+      const int k0 = b * kSlabSlices, k1 = std::min(g.nz, k0 + kSlabSlices);
+      std::size_t found = 0;
+      for (int j = 0; j < g.ny; ++j)
+        for (int k = k0; k < k1; ++k) {
+          SliceResult& out = slices[static_cast<std::size_t>(k)];
+          const int count = scanner.scan(j, k, row);
+          const std::uint32_t base = static_cast<std::uint32_t>(g.linear(0, j, k));
           for (int n = 0; n < count; ++n) {
-            const int i = alive[n];
-            const float s = image.sample_inside(uc[i], vc[i]);
-            product[i] = s;
-            alive[kept] = i;
-            kept += s > 0.0f;
+            const int i = row.alive[static_cast<std::size_t>(n)];
+            out.index.push_back(base + static_cast<std::uint32_t>(i));
+            out.value.push_back(row.product[static_cast<std::size_t>(i)]);
           }
-          count = kept;
+          found += static_cast<std::size_t>(count);
         }
-        for (std::size_t o = 1; o < cams && count > 0; ++o) {
-          const std::size_t c = order[o];
-          float* uc = u.data() + c * g.nx;
-          float* vc = v.data() + c * g.nx;
-          projector.row_at(c, j, k, alive.data(), count, uc, vc);
-          const SampledImage& image = images[c];
-          int kept = 0;
-          for (int n = 0; n < count; ++n) {
-            const int i = alive[n];
-            const float s = image.reaches(uc[i], vc[i]) ? image.sample_inside(uc[i], vc[i]) : 0.0f;
-            product[i] *= s;
-            alive[kept] = i;
-            kept += s > 0.0f;
-          }
-          count = kept;
-        }
-        for (int n = 0; n < count; ++n) {
-          const int i = alive[n];
-          out.index.push_back(static_cast<std::uint32_t>(g.linear(i, j, k)));
-          out.value.push_back(product[i]);
-        }
-      }
-      const std::size_t total = active.fetch_add(out.index.size()) + out.index.size();
+      const std::size_t total = active.fetch_add(found) + found;
       if (static_cast<double>(total) > budget_voxels) over_budget.store(true);
+    }
+    if (profiling_enabled()) {
+#pragma omp critical
+      {
+        std::fprintf(stderr, "[profile] mlos thread: voxels tested per camera");
+        for (std::size_t o = 0; o < row.tested.size(); ++o)
+          std::fprintf(stderr, " %zu: %llu (reach %.3f),", scanner.order()[o],
+                       static_cast<unsigned long long>(row.tested[o]), scanner.image(scanner.order()[o]).reach_fraction);
+        std::fprintf(stderr, " reachable in all: %llu\n", static_cast<unsigned long long>(row.reached));
+      }
     }
   }
   if (over_budget.load()) {

@@ -1,4 +1,7 @@
 // MLOS as a reconstructor in its own right: the support and its product intensities.
+#include <algorithm>
+#include <utility>
+
 #include "algorithms.h"
 #include "support.h"
 
@@ -18,7 +21,16 @@ class MlosReconstructor final : public Reconstructor {
     needs.mlos_threshold = options_.mlos_threshold;
     needs.positions = false;
     Support s = build_support(input, options_, needs, report);
-    SparseVolume volume = to_volume(s.in.grid, s.set.index, s.set.value);
+    // MLOS keeps only voxels whose every read is > 0, so the support is normally the volume
+    // itself: hand its arrays over instead of copying them into fresh (first-touched) memory.
+    SparseVolume volume;
+    if (std::all_of(s.set.value.begin(), s.set.value.end(), [](float e) { return e > 0.0f; })) {
+      volume.grid = s.in.grid;
+      volume.index = std::move(s.set.index);
+      volume.intensity = std::move(s.set.value);
+    } else {
+      volume = to_volume(s.in.grid, s.set.index, s.set.value);
+    }
     finish_report(report, start, volume);
     return volume;
   }
