@@ -43,6 +43,24 @@ void reach_pass_scalar(const SegmentPass& p, int a_first, int a_last) {
   }
 }
 
+// The reach test of one camera for the listed voxels only (alive[0 .. count-1], ascending),
+// with the dense passes' arithmetic: voxel i belongs to segment min(i / step, segments - 1).
+// Used once few voxels are left, where a dense pass would test mostly dead ones.
+void reach_list(const SegmentPass& p, const int* alive, int count) {
+  for (int n = 0; n < count; ++n) {
+    const int i = alive[n];
+    const int a = std::min(i / p.step, p.segments - 1);
+    const float off = static_cast<float>(i - a * p.step);
+    const float uu = p.u0[a] + p.du[a] * off, vv = p.v0[a] + p.dv[a] * off;
+    p.u[i] = uu;
+    p.v[i] = vv;
+    const float cu = std::min(std::max(uu, -0.5f), p.u_max), cv = std::min(std::max(vv, -0.5f), p.v_max);
+    const std::uint32_t inside = (cu == uu) & (cv == vv);
+    const auto cell = static_cast<std::uint32_t>(static_cast<int>(cv + 1.0f) * p.stride + static_cast<int>(cu + 1.0f));
+    p.reachable[i] &= inside & (p.bits[cell >> 5] >> (cell & 31u));
+  }
+}
+
 #if defined(__x86_64__)
 // GCC 12's AVX-512 headers trip -Wmaybe-uninitialized on their own _mm512_undefined values.
 #pragma GCC diagnostic push
@@ -102,6 +120,9 @@ __attribute__((target("avx512f"))) int list_reachable_avx512(const std::uint32_t
 #endif
 
 std::atomic<bool> vector_pass_allowed{true};
+
+// Survivors fewer than 1 / kSparseFactor of their span switch the later cameras to listed tests.
+constexpr int kSparseFactor = 4;
 
 bool vector_kernels() {
 #if defined(__x86_64__)
@@ -193,6 +214,8 @@ int SupportScanner::scan(int j, int k, Row& row) const {
   std::uint32_t* reachable = row.reachable.data();
   std::fill(reachable, reachable + nx, 1u);
   int first = 0, last = nx_;
+  int* alive = row.alive.data();
+  int listed = -1;  // >= 0: the survivors are listed in alive[0 .. listed-1] (sparse passes)
   for (std::size_t o = 0; o < order_.size(); ++o) {
     const std::size_t c = order_[o];
     const ThresholdedImage& im = images_[c];
@@ -202,6 +225,27 @@ int SupportScanner::scan(int j, int k, Row& row) const {
                      im.reach_bits.data(), im.stride, static_cast<float>(im.width) - 0.5f,
                      static_cast<float>(im.height) - 0.5f, uc, vc, reachable};
     pass.segments = projector_.row_segments(c, j, k, row.u0.data(), row.du.data(), row.v0.data(), row.dv.data());
+    if (listed >= 0) {
+      // Sparse: test only the listed survivors, then drop the ones this camera rejects.
+      if (pass.segments > 0) {
+        reach_list(pass, alive, listed);
+      } else {
+        projector_.row_at(c, j, k, alive, listed, uc, vc);
+        for (int n = 0; n < listed; ++n) {
+          const int i = alive[n];
+          reachable[i] &= static_cast<std::uint32_t>(im.in_span(uc[i], vc[i]) && im.reach[im.cell(uc[i], vc[i])]);
+        }
+      }
+      row.tested[o] += static_cast<std::uint64_t>(listed);
+      int kept = 0;
+      for (int n = 0; n < listed; ++n) {
+        alive[kept] = alive[n];
+        kept += static_cast<int>(reachable[alive[n]] != 0);
+      }
+      listed = kept;
+      if (listed == 0) return 0;
+      continue;
+    }
     if (pass.segments > 0) {
       const int a_first = std::min(first / pass.step, pass.segments - 1);
       const int a_last = std::min((last - 1) / pass.step, pass.segments - 1) + 1;
@@ -215,11 +259,16 @@ int SupportScanner::scan(int j, int k, Row& row) const {
     while (first < last && reachable[first] == 0) ++first;
     while (last > first && reachable[last - 1] == 0) --last;
     if (first == last) return 0;
+    // Once the survivors are a small part of their span, later cameras test the list instead
+    // of the span: a dense pass costs ~0.6 ns per voxel with AVX-512, a listed voxel a few ns.
+    if (o + 1 < order_.size()) {
+      const int survivors = list_reachable(reachable, first, last, alive);
+      if (survivors * kSparseFactor < last - first) listed = survivors;
+    }
   }
   // Voxels reachable in every camera: read them, keep those whose reads are all > 0.
-  int* alive = row.alive.data();
   float* product = row.product.data();
-  const int count = list_reachable(reachable, first, last, alive);
+  const int count = listed >= 0 ? listed : list_reachable(reachable, first, last, alive);
   row.reached += static_cast<std::uint64_t>(count);
   int kept = 0;
   for (int n = 0; n < count; ++n) {
