@@ -13,7 +13,8 @@
 //   voxels and was no faster: with a quarter of the cells reachable the runs are short and
 //   every decision is a mispredicted branch.
 // - Cameras after the first only pass over the span between the first and last voxel still
-//   alive, and the scan stops at a camera that leaves no voxel alive.
+//   alive, and the scan stops at a camera that leaves no voxel alive. Once the survivors are
+//   fewer than a quarter of that span, the later cameras test the listed survivors instead.
 // - Only the voxels reachable in every camera are read (bilinear, in order()), and those whose
 //   reads are all > 0 are kept.
 #include <algorithm>
