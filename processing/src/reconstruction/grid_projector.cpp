@@ -116,6 +116,32 @@ double GridProjector::measure_error(const Lattice& l, int threads) const {
   return worst;
 }
 
+namespace {
+
+// Row segments of up to this many lattice nodes live on the stack; longer rows (over 16 000
+// voxels at the coarsest step) take a heap buffer.
+constexpr int kStackNodes = 1024;
+
+// Scratch for one row's segments: u0, du, v0, dv of `nodes` entries each.
+class SegmentBuffer {
+ public:
+  explicit SegmentBuffer(int nodes) {
+    if (nodes > kStackNodes) heap_.resize(static_cast<std::size_t>(nodes) * 4);
+    float* base = heap_.empty() ? stack_ : heap_.data();
+    u0 = base;
+    du = base + nodes;
+    v0 = base + 2 * nodes;
+    dv = base + 3 * nodes;
+  }
+  float *u0, *du, *v0, *dv;
+
+ private:
+  float stack_[4 * kStackNodes];
+  std::vector<float> heap_;
+};
+
+}  // namespace
+
 void GridProjector::row(std::size_t c, int j, int k, float* u, float* v) const {
   const Lattice& l = cams_[c];
   if (l.step == 1) {
@@ -126,28 +152,15 @@ void GridProjector::row(std::size_t c, int j, int k, float* u, float* v) const {
     }
     return;
   }
-  const int s = l.step;
-  const int cb = std::min(j / s, l.nodes_y - 2), cc = std::min(k / s, l.nodes_z - 2);
-  const float fb = static_cast<float>(j - cb * s) / s, fc = static_cast<float>(k - cc * s) / s;
-  const float w00 = (1 - fb) * (1 - fc), w10 = fb * (1 - fc), w01 = (1 - fb) * fc, w11 = fb * fc;
-  const std::size_t plane = static_cast<std::size_t>(l.nodes_x) * l.nodes_y;
-  const std::size_t r00 = static_cast<std::size_t>(l.nodes_x) * cb + plane * cc;
-  const std::size_t r10 = r00 + l.nodes_x, r01 = r00 + plane, r11 = r00 + plane + l.nodes_x;
-  float prev_u = 0, prev_v = 0;
-  for (int a = 0; a < l.nodes_x; ++a) {
-    // Bilinear in (j, k) at this lattice column, then linear along the row to the next one.
-    const float nu = w00 * l.u[r00 + a] + w10 * l.u[r10 + a] + w01 * l.u[r01 + a] + w11 * l.u[r11 + a];
-    const float nv = w00 * l.v[r00 + a] + w10 * l.v[r10 + a] + w01 * l.v[r01 + a] + w11 * l.v[r11 + a];
-    if (a > 0) {
-      const int i0 = (a - 1) * s, i1 = a == l.nodes_x - 1 ? grid_.nx : std::min(a * s, grid_.nx);
-      const float du = (nu - prev_u) / s, dv = (nv - prev_v) / s;
-      for (int i = i0; i < i1; ++i) {
-        u[i] = prev_u + du * (i - i0);
-        v[i] = prev_v + dv * (i - i0);
-      }
+  SegmentBuffer seg(l.nodes_x);
+  const int segments = row_segments(c, j, k, seg.u0, seg.du, seg.v0, seg.dv);
+  for (int a = 0; a < segments; ++a) {
+    const int i0 = a * l.step, i1 = a == segments - 1 ? grid_.nx : std::min(i0 + l.step, grid_.nx);
+    for (int i = i0; i < i1; ++i) {
+      const float off = static_cast<float>(i - i0);
+      u[i] = seg.u0[a] + seg.du[a] * off;
+      v[i] = seg.v0[a] + seg.dv[a] * off;
     }
-    prev_u = nu;
-    prev_v = nv;
   }
 }
 
@@ -163,37 +176,15 @@ void GridProjector::row_at(std::size_t c, int j, int k, const int* voxels, int c
     return;
   }
   if (count == 0) return;
-  const int s = l.step;
-  const int cb = std::min(j / s, l.nodes_y - 2), cc = std::min(k / s, l.nodes_z - 2);
-  const float fb = static_cast<float>(j - cb * s) / s, fc = static_cast<float>(k - cc * s) / s;
-  const float w00 = (1 - fb) * (1 - fc), w10 = fb * (1 - fc), w01 = (1 - fb) * fc, w11 = fb * fc;
-  const std::size_t plane = static_cast<std::size_t>(l.nodes_x) * l.nodes_y;
-  const std::size_t r00 = static_cast<std::size_t>(l.nodes_x) * cb + plane * cc;
-  const std::size_t r10 = r00 + l.nodes_x, r01 = r00 + plane, r11 = r00 + plane + l.nodes_x;
-  // The row's lattice nodes (a few dozen), then each listed voxel from its segment, with the
-  // same arithmetic as row().
-  constexpr int kMaxNodes = 256;
-  float nu[kMaxNodes], nv[kMaxNodes];
-  if (l.nodes_x > kMaxNodes) {
-    std::vector<float> fu(static_cast<std::size_t>(grid_.nx)), fv(static_cast<std::size_t>(grid_.nx));
-    row(c, j, k, fu.data(), fv.data());
-    for (int n = 0; n < count; ++n) {
-      u[voxels[n]] = fu[static_cast<std::size_t>(voxels[n])];
-      v[voxels[n]] = fv[static_cast<std::size_t>(voxels[n])];
-    }
-    return;
-  }
-  for (int a = 0; a < l.nodes_x; ++a) {
-    nu[a] = w00 * l.u[r00 + a] + w10 * l.u[r10 + a] + w01 * l.u[r01 + a] + w11 * l.u[r11 + a];
-    nv[a] = w00 * l.v[r00 + a] + w10 * l.v[r10 + a] + w01 * l.v[r01 + a] + w11 * l.v[r11 + a];
-  }
+  // The row's segments (a few dozen), then each listed voxel from its own, as row() does.
+  SegmentBuffer seg(l.nodes_x);
+  const int segments = row_segments(c, j, k, seg.u0, seg.du, seg.v0, seg.dv);
   for (int n = 0; n < count; ++n) {
     const int i = voxels[n];
-    const int a = std::min(i / s, l.nodes_x - 2);
-    const int i0 = a * s;
-    const float du = (nu[a + 1] - nu[a]) / s, dv = (nv[a + 1] - nv[a]) / s;
-    u[i] = nu[a] + du * (i - i0);
-    v[i] = nv[a] + dv * (i - i0);
+    const int a = std::min(i / l.step, segments - 1);
+    const float off = static_cast<float>(i - a * l.step);
+    u[i] = seg.u0[a] + seg.du[a] * off;
+    v[i] = seg.v0[a] + seg.dv[a] * off;
   }
 }
 

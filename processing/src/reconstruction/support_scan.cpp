@@ -27,38 +27,28 @@ struct SegmentPass {
   int end_of(int a) const { return a == segments - 1 ? nx : std::min(a * step + step, nx); }
 };
 
+// Voxel i of segment a: its position (stored) and its reach bit (and-ed into reachable[i]).
+inline void test_voxel(const SegmentPass& p, int a, int i) {
+  const float off = static_cast<float>(i - a * p.step);
+  const float uu = p.u0[a] + p.du[a] * off, vv = p.v0[a] + p.dv[a] * off;
+  p.u[i] = uu;
+  p.v[i] = vv;
+  const float cu = std::min(std::max(uu, -0.5f), p.u_max), cv = std::min(std::max(vv, -0.5f), p.v_max);
+  const std::uint32_t inside = (cu == uu) & (cv == vv);
+  const auto cell = static_cast<std::uint32_t>(static_cast<int>(cv + 1.0f) * p.stride + static_cast<int>(cu + 1.0f));
+  p.reachable[i] &= inside & (p.bits[cell >> 5] >> (cell & 31u));
+}
+
 void reach_pass_scalar(const SegmentPass& p, int a_first, int a_last) {
-  for (int a = a_first; a < a_last; ++a) {
-    const int i0 = a * p.step, i1 = p.end_of(a);
-    for (int i = i0; i < i1; ++i) {
-      const float off = static_cast<float>(i - i0);
-      const float uu = p.u0[a] + p.du[a] * off, vv = p.v0[a] + p.dv[a] * off;
-      p.u[i] = uu;
-      p.v[i] = vv;
-      const float cu = std::min(std::max(uu, -0.5f), p.u_max), cv = std::min(std::max(vv, -0.5f), p.v_max);
-      const std::uint32_t inside = (cu == uu) & (cv == vv);
-      const auto cell = static_cast<std::uint32_t>(static_cast<int>(cv + 1.0f) * p.stride + static_cast<int>(cu + 1.0f));
-      p.reachable[i] &= inside & (p.bits[cell >> 5] >> (cell & 31u));
-    }
-  }
+  for (int a = a_first; a < a_last; ++a)
+    for (int i = a * p.step, i1 = p.end_of(a); i < i1; ++i) test_voxel(p, a, i);
 }
 
 // The reach test of one camera for the listed voxels only (alive[0 .. count-1], ascending),
 // with the dense passes' arithmetic: voxel i belongs to segment min(i / step, segments - 1).
 // Used once few voxels are left, where a dense pass would test mostly dead ones.
 void reach_list(const SegmentPass& p, const int* alive, int count) {
-  for (int n = 0; n < count; ++n) {
-    const int i = alive[n];
-    const int a = std::min(i / p.step, p.segments - 1);
-    const float off = static_cast<float>(i - a * p.step);
-    const float uu = p.u0[a] + p.du[a] * off, vv = p.v0[a] + p.dv[a] * off;
-    p.u[i] = uu;
-    p.v[i] = vv;
-    const float cu = std::min(std::max(uu, -0.5f), p.u_max), cv = std::min(std::max(vv, -0.5f), p.v_max);
-    const std::uint32_t inside = (cu == uu) & (cv == vv);
-    const auto cell = static_cast<std::uint32_t>(static_cast<int>(cv + 1.0f) * p.stride + static_cast<int>(cu + 1.0f));
-    p.reachable[i] &= inside & (p.bits[cell >> 5] >> (cell & 31u));
-  }
+  for (int n = 0; n < count; ++n) test_voxel(p, std::min(alive[n] / p.step, p.segments - 1), alive[n]);
 }
 
 #if defined(__x86_64__)
