@@ -131,13 +131,7 @@ std::string xdmf_for_result_rows(const std::string& file_name, const XdmfFieldGr
 std::string xdmf_for_results(const std::string& file_name, const XdmfFieldGrid& g, const std::vector<std::string>& sets,
                              bool has_statistics) {
   // File names are written by tomorig from a path; escape the XML specials anyway.
-  std::string file;
-  for (char c : file_name) {
-    if (c == '&') file += "&amp;";
-    else if (c == '<') file += "&lt;";
-    else if (c == '>') file += "&gt;";
-    else file += c;
-  }
+  const std::string file = escaped(file_name);
   std::string out =
       "<?xml version=\"1.0\" ?>\n"
       "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
