@@ -114,7 +114,12 @@ TEST(BenchReconCli, RepeatReportsWarmRoundsOfTheSameReconstruction) {
   // Repeating changes the timing, never the result: the judged volume is the same.
   EXPECT_EQ(a["active_voxels"], b["active_voxels"]);
   EXPECT_DOUBLE_EQ(a["q_global"].get<double>(), b["q_global"].get<double>());
-  EXPECT_NE(run_tomorig("bench recon --repeat 0 --grid 96,96,24,0.0195").exit_code, 0);
+  // Bad choices are refused as usage errors before any work, naming the option.
+  for (const char* bad : {"--repeat 0", "--initial random", "--sigma-px -1", "--patch 99"}) {
+    const CliResult r = run_tomorig(std::string("bench recon --grid 96,96,24,0.0195 ") + bad);
+    EXPECT_EQ(r.exit_code, 2) << bad << "\n" << r.err;
+    EXPECT_NE(r.err.find(std::string(bad).substr(0, std::string(bad).find(' '))), std::string::npos) << bad << "\n" << r.err;
+  }
 }
 
 }  // namespace
