@@ -39,6 +39,8 @@ struct BenchPiv3dArgs {
   CorrelationArgs correlation;
   int iterations = 0;
   double sigma_px = 0.0;  // reconstruction weight sigma, all cameras; 0: the library default
+  double prune_fraction = -1.0;  // < 0: the library default
+  double mlos_threshold = -1.0;  // < 0: the library default
   std::string fmart_smoothing = "0.68,0.68,0.1";
   std::uint64_t seed = 1;
   int threads = 0;
@@ -193,6 +195,9 @@ void run(const BenchPiv3dArgs& args) {
         o.algorithm = source;
         o.threads = args.threads;
         if (args.iterations > 0) o.max_iterations = args.iterations;
+        if (args.prune_fraction >= 0) o.prune_fraction = args.prune_fraction;
+        if (args.mlos_threshold >= 0) o.mlos_threshold = args.mlos_threshold;
+        o.validate();
         const auto reconstructor = recon::make_reconstructor(o);
         recon::ReconstructionInput input;
         for (std::size_t c = 0; c < rig.cameras().size(); ++c) {
@@ -245,6 +250,8 @@ void run(const BenchPiv3dArgs& args) {
                               {"weighting", shown.weighting},
                               {"fmart_smoothing", args.fmart_smoothing},
                               {"sigma_px", args.sigma_px > 0 ? nlohmann::json(args.sigma_px) : nlohmann::json("default")},
+                              {"prune_fraction", args.prune_fraction >= 0 ? nlohmann::json(args.prune_fraction) : nlohmann::json("default")},
+                              {"mlos_threshold", args.mlos_threshold >= 0 ? nlohmann::json(args.mlos_threshold) : nlohmann::json("default")},
                               {"seed", args.seed},
                               {"boundary_nodes_excluded", 1},
                               {"machine", machine_json()},
@@ -272,6 +279,13 @@ void add_bench_piv3d_command(CLI::App& bench) {
   cmd->add_option("--sigma-px", args->sigma_px,
                   "Reconstruction weight sigma, pixels, all cameras (0: the library default)")
       ->check(CLI::Range(0.0, 10.0))
+      ->capture_default_str();
+  cmd->add_option("--prune", args->prune_fraction,
+                  "SMART/FMART: drop voxels below this fraction of the largest intensity after each iteration "
+                  "(0: never; negative: the library default)")
+      ->capture_default_str();
+  cmd->add_option("--mlos-threshold", args->mlos_threshold,
+                  "MLOS empty-pixel fraction of the image maximum (negative: the library default)")
       ->capture_default_str();
   cmd->add_option("--fmart-smoothing", args->fmart_smoothing,
                   "Gaussian sigma x,y,z (voxel) applied to FMART volumes before correlation, as the thesis did; 0: none")
