@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench_common.h"
+#include "bench_recon_tuning.h"
 #include "process_correlation.h"
 #include "report_json.h"
 #include "session_geometry.h"
@@ -38,8 +39,7 @@ struct BenchPiv3dArgs {
   double particles_per_window = 10.0;
   CorrelationArgs correlation;
   int iterations = 0;
-  double sigma_px = 0.0;  // reconstruction weight sigma, all cameras; 0: the library default
-  double prune_fraction = -1.0;  // < 0: the library default
+  BenchReconTuning tuning;  // --sigma-px, --prune
   double mlos_threshold = -1.0;  // < 0: the library default
   std::string fmart_smoothing = "0.68,0.68,0.1";
   std::uint64_t seed = 1;
@@ -195,7 +195,7 @@ void run(const BenchPiv3dArgs& args) {
         o.algorithm = source;
         o.threads = args.threads;
         if (args.iterations > 0) o.max_iterations = args.iterations;
-        if (args.prune_fraction >= 0) o.prune_fraction = args.prune_fraction;
+        args.tuning.apply(o);
         if (args.mlos_threshold >= 0) o.mlos_threshold = args.mlos_threshold;
         o.validate();
         const auto reconstructor = recon::make_reconstructor(o);
@@ -205,7 +205,7 @@ void run(const BenchPiv3dArgs& args) {
           input.sensor_sizes.push_back({rig.cameras()[c].spec.width, rig.cameras()[c].spec.height});
         }
         input.grid = grid;
-        if (args.sigma_px > 0) input.psf.assign(input.cameras.size(), recon::PsfModel::constant(args.sigma_px));
+        args.tuning.apply(input);
         const bool smooth = source == "fmart" && (smoothing.x > 0 || smoothing.y > 0 || smoothing.z > 0);
         for (const Exposure e : {Exposure::A, Exposure::B}) {
           input.images.clear();
@@ -249,8 +249,8 @@ void run(const BenchPiv3dArgs& args) {
                               {"deformation_passes", shown.deformation_passes},
                               {"weighting", shown.weighting},
                               {"fmart_smoothing", args.fmart_smoothing},
-                              {"sigma_px", args.sigma_px > 0 ? nlohmann::json(args.sigma_px) : nlohmann::json("default")},
-                              {"prune_fraction", args.prune_fraction >= 0 ? nlohmann::json(args.prune_fraction) : nlohmann::json("default")},
+                              {"sigma_px", args.tuning.sigma_json()},
+                              {"prune_fraction", args.tuning.prune_in_effect()},
                               {"mlos_threshold", args.mlos_threshold >= 0 ? nlohmann::json(args.mlos_threshold) : nlohmann::json("default")},
                               {"seed", args.seed},
                               {"boundary_nodes_excluded", 1},
@@ -276,14 +276,7 @@ void add_bench_piv3d_command(CLI::App& bench) {
   cmd->add_option("--particles-per-window", args->particles_per_window, "Target of --window auto")
       ->capture_default_str();
   cmd->add_option("--iterations", args->iterations, "Reconstruction iterations (0: the algorithm's default)");
-  cmd->add_option("--sigma-px", args->sigma_px,
-                  "Reconstruction weight sigma, pixels, all cameras (0: the library default)")
-      ->check(CLI::Range(0.0, 10.0))
-      ->capture_default_str();
-  cmd->add_option("--prune", args->prune_fraction,
-                  "SMART/FMART: drop voxels below this fraction of the largest intensity after each iteration "
-                  "(0: never; negative: the library default)")
-      ->capture_default_str();
+  args->tuning.add_options(*cmd);
   cmd->add_option("--mlos-threshold", args->mlos_threshold,
                   "MLOS empty-pixel fraction of the image maximum (negative: the library default)")
       ->capture_default_str();

@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench_common.h"
+#include "bench_recon_tuning.h"
 #include "report_json.h"
 #include "session_geometry.h"
 #include "tomorig/core/error.h"
@@ -38,8 +39,7 @@ struct BenchReconArgs {
   int iterations = 0;
   double relaxation = 1.0;
   double mlos_threshold = 0.05;
-  double prune_fraction = -1.0;  // < 0: the library default
-  double sigma_px = 0.0;          // weight sigma, all cameras; 0: the library default
+  BenchReconTuning tuning;        // --sigma-px, --prune
   int patch = 0;                  // patch edge p; 0: the library default (ceil(4 sigma), odd)
   int repeat = 1;                 // rounds per algorithm; rounds after the first are "warm"
   std::string initial = "mlos";  // SMART/FMART start: MLOS intensities or 1 ("uniform", as the thesis)
@@ -56,10 +56,6 @@ struct BenchReconArgs {
   int exposures = 0;  // 1: A only, 2: A and B (a double exposure); 0: the case's default
   double max_truth_mb = 1024.0;
 };
-
-double base_prune_fraction(const BenchReconArgs& args) {
-  return args.prune_fraction >= 0 ? args.prune_fraction : recon::ReconstructionOptions{}.prune_fraction;
-}
 
 // The density ../shared/benchmarks/README.md defines each case at: the spray scale case at
 // 0.03 ppp (at 0.05 its support is 3.3 x larger), tpiv-thesis's headline figures at 0.05.
@@ -177,7 +173,7 @@ void run(const BenchReconArgs& args) {
   recon::ReconstructionOptions base;
   base.relaxation = args.relaxation;
   base.mlos_threshold = args.mlos_threshold;
-  if (args.prune_fraction >= 0) base.prune_fraction = args.prune_fraction;
+  args.tuning.apply(base);
   base.mlos_initial_intensity = args.initial == "mlos";
   base.patch_size = args.patch;
   base.threads = args.threads;
@@ -218,7 +214,7 @@ void run(const BenchReconArgs& args) {
         input.sensor_sizes.push_back({rig.cameras()[c].spec.width, rig.cameras()[c].spec.height});
       }
       input.grid = grid;
-      if (args.sigma_px > 0) input.psf.assign(input.cameras.size(), recon::PsfModel::constant(args.sigma_px));
+      args.tuning.apply(input);
       return input;
     };
     // Q needs the dense truth volume (and the quality code's own dense copies): judge only
@@ -316,9 +312,9 @@ void run(const BenchReconArgs& args) {
                               {"grid", {case_grid.nx, case_grid.ny, case_grid.nz}},
                               {"exposure", exposures == 1 ? "A" : "A+B"},
                               {"mlos_threshold", args.mlos_threshold},
-                              {"prune_fraction", base_prune_fraction(args)},
+                              {"prune_fraction", args.tuning.prune_in_effect()},
                               {"initial_intensity", args.initial},
-                              {"sigma_px", args.sigma_px > 0 ? nlohmann::json(args.sigma_px) : nlohmann::json("default")},
+                              {"sigma_px", args.tuning.sigma_json()},
                               {"patch", args.patch},
                               {"seed", args.seed},
                               {"machine", machine_json()},
@@ -343,14 +339,7 @@ void add_bench_recon_command(CLI::App& bench) {
   cmd->add_option("--relaxation", args->relaxation, "Relaxation mu in (0, 2]")->capture_default_str();
   cmd->add_option("--mlos-threshold", args->mlos_threshold, "MLOS empty-pixel fraction of the image maximum")
       ->capture_default_str();
-  cmd->add_option("--prune", args->prune_fraction,
-                  "SMART/FMART: drop voxels below this fraction of the largest intensity after each iteration "
-                  "(0: never; negative: the library default)")
-      ->capture_default_str();
-  cmd->add_option("--sigma-px", args->sigma_px,
-                  "Gaussian sigma of the voxel-to-pixel weights, pixels, all cameras (0: the library default)")
-      ->check(CLI::Range(0.0, 10.0))
-      ->capture_default_str();
+  args->tuning.add_options(*cmd);
   cmd->add_option("--patch", args->patch, "Patch edge p of SMART/FMART/MART (0: ceil(4 sigma), odd, >= 3)")
       ->check(CLI::Range(0, 15))
       ->capture_default_str();

@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench_common.h"
+#include "bench_recon_tuning.h"
 #include "session_geometry.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/quality/quality_factor.h"
@@ -35,8 +36,7 @@ struct RaceArgs {
   double fmart_relaxation = 1.0;
   double smart_relaxation = 1.5;
   double mlos_threshold = 0.05;
-  double prune_fraction = -1.0;  // < 0: the library default
-  double sigma_px = 0.0;         // weight sigma, all cameras; 0: the library default
+  BenchReconTuning tuning;       // --sigma-px, --prune
   double q_target = 0.0;         // 0: the lower of the two algorithms' best Q, per density
   std::string smoothing = "0.68,0.68,0.1";
   std::string grid;
@@ -108,7 +108,7 @@ Run race_one(const std::string& algorithm, int iterations, double relaxation, co
   o.relaxation = relaxation;
   o.mlos_threshold = args.mlos_threshold;
   o.threads = args.threads;
-  if (args.prune_fraction >= 0) o.prune_fraction = args.prune_fraction;
+  args.tuning.apply(o);
   const bool smooth = smoothing.x > 0 || smoothing.y > 0 || smoothing.z > 0;
 
   Run run;
@@ -181,7 +181,7 @@ void run(const RaceArgs& args) {
     o.algorithm = a;
     o.relaxation = mu;
     o.mlos_threshold = args.mlos_threshold;
-    if (args.prune_fraction >= 0) o.prune_fraction = args.prune_fraction;
+    args.tuning.apply(o);
     o.validate();
   }
 
@@ -204,7 +204,7 @@ void run(const RaceArgs& args) {
       input.sensor_sizes.push_back({rig.cameras()[c].spec.width, rig.cameras()[c].spec.height});
     }
     input.grid = grid;
-    if (args.sigma_px > 0) input.psf.assign(input.cameras.size(), recon::PsfModel::constant(args.sigma_px));
+    args.tuning.apply(input);
     const quality::QualityEvaluator judge(grid, set.particles_a);
 
     const Run fmart = race_one("fmart", args.fmart_iterations, args.fmart_relaxation, args, input, judge, smoothing);
@@ -236,8 +236,8 @@ void run(const RaceArgs& args) {
       {"exposure", "A"},
       {"seed", args.seed},
       {"mlos_threshold", args.mlos_threshold},
-      {"prune_fraction", args.prune_fraction >= 0 ? args.prune_fraction : recon::ReconstructionOptions{}.prune_fraction},
-      {"sigma_px", args.sigma_px > 0 ? nlohmann::json(args.sigma_px) : nlohmann::json("default")},
+      {"prune_fraction", args.tuning.prune_in_effect()},
+      {"sigma_px", args.tuning.sigma_json()},
       {"smoothing_sigma_voxel", nlohmann::json{smoothing.x, smoothing.y, smoothing.z}},
       {"q", "windowed Q (Eq. 3.14, 64^3 windows) of the smoothed volume; time excludes the judging"},
       {"machine", machine_json()},
@@ -259,14 +259,7 @@ void add_bench_recon_race_command(CLI::App& bench) {
   cmd->add_option("--smart-relaxation", args->smart_relaxation, "SMART mu in (0, 2]")->capture_default_str();
   cmd->add_option("--mlos-threshold", args->mlos_threshold, "MLOS empty-pixel fraction of the image maximum")
       ->capture_default_str();
-  cmd->add_option("--prune", args->prune_fraction,
-                  "Drop voxels below this fraction of the largest intensity after each iteration, both "
-                  "algorithms (0: never; negative: the library default)")
-      ->capture_default_str();
-  cmd->add_option("--sigma-px", args->sigma_px,
-                  "Gaussian sigma of the voxel-to-pixel weights, pixels, all cameras (0: the library default)")
-      ->check(CLI::Range(0.0, 10.0))
-      ->capture_default_str();
+  args->tuning.add_options(*cmd);
   cmd->add_option("--q-target", args->q_target,
                   "Windowed Q both must reach (0: the lower of the two algorithms' best Q at each density)")
       ->capture_default_str();
