@@ -188,6 +188,33 @@ void GridProjector::row_at(std::size_t c, int j, int k, const int* voxels, int c
   }
 }
 
+GridProjector::Slopes GridProjector::slopes(std::size_t c) const {
+  const Lattice& l = cams_[c];
+  Slopes out;
+  if (l.step == 1) return out;
+  for (float u : l.u)
+    if (u == kNowhere) return out;
+  // The positions are trilinear within a lattice cell, so their partial derivatives there are
+  // bounded by the node differences along the cell's edges.
+  const int strides[3] = {1, l.nodes_x, l.nodes_x * l.nodes_y};
+  const int nodes[3] = {l.nodes_x, l.nodes_y, l.nodes_z};
+  const float inverse = 1.0f / static_cast<float>(l.step);
+  for (int c2 = 0; c2 < l.nodes_z; ++c2)
+    for (int b = 0; b < l.nodes_y; ++b)
+      for (int a = 0; a < l.nodes_x; ++a) {
+        const int at[3] = {a, b, c2};
+        const std::size_t n = static_cast<std::size_t>(a) + l.nodes_x * (static_cast<std::size_t>(b) + l.nodes_y * c2);
+        for (int axis = 0; axis < 3; ++axis) {
+          if (at[axis] + 1 >= nodes[axis]) continue;
+          const std::size_t m = n + static_cast<std::size_t>(strides[axis]);
+          out.u[axis] = std::max(out.u[axis], std::fabs(l.u[m] - l.u[n]) * inverse);
+          out.v[axis] = std::max(out.v[axis], std::fabs(l.v[m] - l.v[n]) * inverse);
+        }
+      }
+  out.defined = true;
+  return out;
+}
+
 int GridProjector::max_segments() const {
   int most = 1;
   for (const Lattice& l : cams_) most = std::max(most, l.nodes_x);  // one spare: the last node
@@ -195,11 +222,16 @@ int GridProjector::max_segments() const {
 }
 
 int GridProjector::row_segments(std::size_t c, int j, int k, float* u0, float* du, float* v0, float* dv) const {
+  return row_segments(c, j, k, 0.0f, 0.0f, u0, du, v0, dv);
+}
+
+int GridProjector::row_segments(std::size_t c, int j, int k, float dj, float dk, float* u0, float* du, float* v0,
+                                float* dv) const {
   const Lattice& l = cams_[c];
   if (l.step == 1) return 0;
   const int s = l.step;
   const int cb = std::min(j / s, l.nodes_y - 2), cc = std::min(k / s, l.nodes_z - 2);
-  const float fb = static_cast<float>(j - cb * s) / s, fc = static_cast<float>(k - cc * s) / s;
+  const float fb = (static_cast<float>(j - cb * s) + dj) / s, fc = (static_cast<float>(k - cc * s) + dk) / s;
   const float w00 = (1 - fb) * (1 - fc), w10 = fb * (1 - fc), w01 = (1 - fb) * fc, w11 = fb * fc;
   const std::size_t plane = static_cast<std::size_t>(l.nodes_x) * l.nodes_y;
   const std::size_t r00 = static_cast<std::size_t>(l.nodes_x) * cb + plane * cc;

@@ -33,7 +33,23 @@ class GridProjector {
   // entries (u0 and v0 also receive the row's last node). Returns the number of segments; 0
   // for exact projection (step 1).
   int row_segments(std::size_t c, int j, int k, float* u0, float* du, float* v0, float* dv) const;
+  // The same for the line through fractional row and slice positions: j + dj and k + dk, with
+  // dj, dk in [0, 1] and the points j, j + 1 (k, k + 1) in the same lattice cell, as for the
+  // centre of a 2 x 2 block of rows (j even, the step even): the average of the four rows.
+  int row_segments(std::size_t c, int j, int k, float dj, float dk, float* u0, float* du, float* v0, float* dv) const;
   int max_segments() const;
+
+  // The largest change of the interpolated positions in camera c per voxel step along i, j
+  // and k (pixels): a bound on how far apart the images of neighbouring voxels can be, for
+  // conservative coarse tests. `defined` is false for exact projection (step 1) and where a
+  // lattice node lies behind the camera (the interpolant is meaningless there).
+  struct Slopes {
+    bool defined = false;
+    float u[3] = {0, 0, 0}, v[3] = {0, 0, 0};
+  };
+  Slopes slopes(std::size_t c) const;
+
+  const VoxelGrid& grid() const { return grid_; }
 
   // Lattice step used for camera c; 1 means exact projection of every voxel.
   int step(std::size_t c) const { return cams_[c].step; }

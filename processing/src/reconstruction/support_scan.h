@@ -17,6 +17,12 @@
 //   fewer than a quarter of that span, the later cameras test the listed survivors instead.
 // - Only the voxels reachable in every camera are read (bilinear, in order()), and those whose
 //   reads are all > 0 are kept.
+// - Before any of that, a coarse test per 2 x 2 x 2 block of voxels: the block's centre against
+//   each camera's reach mask dilated by the largest distance between a voxel's image and its
+//   block centre's (from the projector's slopes). It is conservative, so the support is the
+//   same; it only lets the passes above start from the blocks that may hold survivors, an
+//   eighth of the tests per camera for the rest. Cameras without a lattice (exact projection)
+//   or whose dilation would exceed kMaxCoarseRadius cells are left out of it.
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -92,6 +98,12 @@ class SupportScanner {
     // in every camera (then read).
     std::vector<std::uint64_t> tested;
     std::uint64_t reached = 0;
+    // The coarse test's results for the last kCoarseRows super-rows (slot K % kCoarseRows),
+    // with their (J, K) keys, and its scratch: block-centre positions, four rows' segments.
+    std::vector<std::uint32_t> coarse, coarse_voxels;  // per slot: per block, and spread to the voxels
+    std::vector<long long> coarse_key;
+    std::vector<int> coarse_span;  // per slot: first and last + 1 voxel that may be a survivor
+    std::vector<float> coarse_u, coarse_v, centre_segments;
   };
   Row make_row() const;
 
@@ -103,12 +115,33 @@ class SupportScanner {
   const std::vector<std::size_t>& order() const { return order_; }  // most selective first
   const ThresholdedImage& image(std::size_t c) const { return images_[c]; }
   std::size_t cameras() const { return images_.size(); }
+  // How many cameras take part in the coarse block test.
+  std::size_t coarse_cameras() const {
+    return static_cast<std::size_t>(std::count_if(coarse_.begin(), coarse_.end(), [](const CoarseCamera& c) { return c.enabled; }));
+  }
 
  private:
+  // A coarse test dilates by at most this many cells; beyond, it would reject too little.
+  static constexpr int kMaxCoarseRadius = 3;
+  // Super-rows remembered per thread: callers scan kSlabSlices slices per grid row.
+  static constexpr std::size_t kCoarseRows = kSlabSlices / 2;
+  struct CoarseCamera {
+    bool enabled = false;
+    std::vector<std::uint32_t> bits;  // the reach mask dilated for the coarse test, packed
+  };
+  struct CoarseRow {
+    const std::uint32_t* mask;  // per voxel of the row: 1 if its block may hold survivors
+    int first, last;            // the voxels outside [first, last) are not survivors
+  };
+  int coarse_nx() const;
+  CoarseRow coarse_row(int big_j, int big_k, Row& row) const;
+
   const GridProjector& projector_;
   int nx_ = 0;
   std::vector<ThresholdedImage> images_;
   std::vector<std::size_t> order_;
+  std::vector<CoarseCamera> coarse_;
+  bool any_coarse_ = false;
 };
 
 }  // namespace tomorig::recon::detail

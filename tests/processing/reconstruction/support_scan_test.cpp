@@ -44,23 +44,14 @@ TEST(SupportScan, VectorAndScalarReachPassesGiveTheSameSupport) {
   }
 }
 
-TEST(SupportScan, SupportIsAscendingAndEqualsAPerVoxelTest) {
-  recon::ReconstructionOptions options;
-  const recon::detail::PreparedInput in = recon::detail::prepare_input(scan_case().input(), options);
-  const double threshold = 0.1;
-  const recon::detail::ActiveSet set = mlos_of(in, threshold);
-  ASSERT_GT(set.size(), 1000u);
-  EXPECT_TRUE(std::is_sorted(set.index.begin(), set.index.end()));
-  EXPECT_EQ(std::adjacent_find(set.index.begin(), set.index.end()), set.index.end());
-  // Reference: every voxel, positions from GridProjector::row, each camera read bilinearly on
-  // the thresholded image (no reach mask, no blocks, no vector code).
+// Reference: every voxel, positions from GridProjector::row, each camera read bilinearly on
+// the thresholded image (no reach mask, no coarse blocks, no vector code).
+std::vector<std::uint32_t> per_voxel_support(const recon::detail::PreparedInput& in, double threshold) {
   const VoxelGrid& g = in.grid;
   const recon::detail::GridProjector projector(in);
   std::vector<recon::detail::ThresholdedImage> images;
   for (const recon::detail::CameraImage& im : in.images) images.emplace_back(im, threshold);
   std::vector<float> u(static_cast<std::size_t>(g.nx)), v(static_cast<std::size_t>(g.nx));
-  std::vector<std::uint32_t> expected;
-  std::vector<float> product(g.voxel_count(), 1.0f);
   std::vector<char> lit(g.voxel_count(), 1);
   for (std::size_t c = 0; c < in.camera_count(); ++c)
     for (int k = 0; k < g.nz; ++k)
@@ -72,9 +63,43 @@ TEST(SupportScan, SupportIsAscendingAndEqualsAPerVoxelTest) {
           lit[n] = lit[n] && s > 0.0f;
         }
       }
+  std::vector<std::uint32_t> expected;
   for (std::size_t n = 0; n < lit.size(); ++n)
     if (lit[n]) expected.push_back(static_cast<std::uint32_t>(n));
-  EXPECT_EQ(set.index, expected);
+  return expected;
+}
+
+TEST(SupportScan, SupportIsAscendingAndEqualsAPerVoxelTest) {
+  recon::ReconstructionOptions options;
+  const recon::detail::PreparedInput in = recon::detail::prepare_input(scan_case().input(), options);
+  const double threshold = 0.1;
+  const recon::detail::ActiveSet set = mlos_of(in, threshold);
+  ASSERT_GT(set.size(), 1000u);
+  EXPECT_TRUE(std::is_sorted(set.index.begin(), set.index.end()));
+  EXPECT_EQ(std::adjacent_find(set.index.begin(), set.index.end()), set.index.end());
+  EXPECT_EQ(set.index, per_voxel_support(in, threshold));
+}
+
+// The coarse 2 x 2 x 2 block test is conservative: with it in play (every camera here has a
+// lattice and a small dilation), and on a grid of odd sizes along every axis (blocks of one
+// voxel, row or slice at the far faces), the support is still exactly the per-voxel one.
+TEST(SupportScan, CoarseBlockTestKeepsExactlyThePerVoxelSupport) {
+  recon::ReconstructionInput input = scan_case().input();
+  input.grid = VoxelGrid::centred(79, 77, 21, scan_case().grid.voxel_size);
+  recon::ReconstructionOptions options;
+  const recon::detail::PreparedInput in = recon::detail::prepare_input(input, options);
+  const recon::detail::GridProjector projector(in);
+  for (double threshold : {0.05, 0.15}) {
+    const recon::detail::SupportScanner scanner(in, projector, threshold);
+    EXPECT_EQ(scanner.coarse_cameras(), in.camera_count());
+    for (const bool vector : {true, false}) {
+      recon::detail::allow_vector_reach_pass(vector);
+      const recon::detail::ActiveSet set = mlos_of(in, threshold);
+      ASSERT_GT(set.size(), 1000u);
+      EXPECT_EQ(set.index, per_voxel_support(in, threshold)) << "threshold " << threshold << ", vector " << vector;
+    }
+    recon::detail::allow_vector_reach_pass(true);
+  }
 }
 
 }  // namespace
