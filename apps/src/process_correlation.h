@@ -15,13 +15,14 @@ struct CorrelationArgs {
   double overlap = 0.75;
   int deformation_passes = 2;
   std::string weighting = "gaussian";
+  double gaussian_sigma = 0.5;  // fraction of the window edge: wide, for reconstructed volumes (docs/correlation.md)
   std::string interpolation = "bspline";
   double min_peak = 0.1;
   double max_displacement = 0.0;
   int threads = 0;
 };
 
-// Adds --window, --overlap, --deformation-passes, --weighting, --interpolation, --min-peak,
+// Adds --window, --overlap, --deformation-passes, --weighting, --gaussian-sigma, --interpolation, --min-peak,
 // --max-displacement to `cmd` (threads come from the command's own --threads).
 void add_correlation_flags(CLI::App& cmd, CorrelationArgs& args);
 

@@ -130,7 +130,7 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
     field.origin = {g.centre(0, g.step.x, g.window.x), g.centre(0, g.step.y, g.window.y), g.centre(0, g.step.z, g.window.z)};
     field.spacing = {double(g.factor * g.step.x), double(g.factor * g.step.y), double(g.factor * g.step.z)};
 
-    const detail::FftCorrelator correlator(g.window, options.weighting);
+    const detail::FftCorrelator correlator(g.window, options.weighting, options.gaussian_sigma);
     const long long node_count = static_cast<long long>(field.count());
     std::size_t fallbacks = 0;
 #pragma omp parallel num_threads(threads) reduction(+ : fallbacks)

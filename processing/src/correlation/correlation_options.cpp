@@ -43,6 +43,9 @@ void CorrelationOptions::validate(const VoxelGrid& grid) const {
     check_axis("y", pass.window.y, pass.downsample, grid.ny, p);
     check_axis("z", pass.window.z, pass.downsample, grid.nz, p);
   }
+  if (!(gaussian_sigma > 0.0 && gaussian_sigma <= 2.0))
+    throw bad_input(fmt::format("correlation: gaussian_sigma = {}; it must lie in (0, 2] (a fraction of the window edge)",
+                                gaussian_sigma));
   if (!(min_peak >= 0.0 && min_peak < 1.0))
     throw bad_input(fmt::format("correlation: min_peak = {}; it must lie in [0, 1)", min_peak));
   if (!(max_displacement >= 0.0) || !std::isfinite(max_displacement))

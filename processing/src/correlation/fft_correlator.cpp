@@ -49,12 +49,13 @@ const PlanPair& plans_for(Int3 w) {
   return it->second;
 }
 
-std::vector<float> axis_weights(int n, WindowWeighting weighting) {
+std::vector<float> axis_weights(int n, WindowWeighting weighting, double gaussian_sigma) {
   std::vector<float> w(n, 1.0f);
   const double centre = 0.5 * (n - 1);
   for (int i = 0; i < n; ++i) {
     const double u = (i - centre) / n;  // -0.5 .. 0.5
-    if (weighting == WindowWeighting::gaussian) w[i] = static_cast<float>(std::exp(-0.5 * (u / 0.25) * (u / 0.25)));
+    if (weighting == WindowWeighting::gaussian)
+      w[i] = static_cast<float>(std::exp(-0.5 * (u / gaussian_sigma) * (u / gaussian_sigma)));
     if (weighting == WindowWeighting::hann)
       w[i] = static_cast<float>(0.5 + 0.5 * std::cos(2.0 * std::numbers::pi * (i + 0.5 - 0.5 * n) / n));
   }
@@ -67,14 +68,15 @@ int signed_lag(int index, int size) { return index < size / 2 ? index : index - 
 
 void FftwFree::operator()(void* p) const { fftwf_free(p); }
 
-FftCorrelator::FftCorrelator(Int3 window, WindowWeighting weighting)
+FftCorrelator::FftCorrelator(Int3 window, WindowWeighting weighting, double gaussian_sigma)
     : window_(window),
       real_count_(static_cast<std::size_t>(window.x) * window.y * window.z),
       complex_count_(static_cast<std::size_t>(window.x / 2 + 1) * window.y * window.z) {
   plans_ = &plans_for(window);
   if (weighting != WindowWeighting::top_hat) {
-    const auto wx = axis_weights(window.x, weighting), wy = axis_weights(window.y, weighting),
-               wz = axis_weights(window.z, weighting);
+    const auto wx = axis_weights(window.x, weighting, gaussian_sigma),
+               wy = axis_weights(window.y, weighting, gaussian_sigma),
+               wz = axis_weights(window.z, weighting, gaussian_sigma);
     weights_.resize(real_count_);
     std::size_t n = 0;
     for (int k = 0; k < window.z; ++k)

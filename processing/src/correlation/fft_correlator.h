@@ -24,7 +24,9 @@ struct WindowPeak {
 
 class FftCorrelator {
  public:
-  FftCorrelator(Int3 window, WindowWeighting weighting);
+  // gaussian_sigma: the Gaussian weighting's standard deviation as a fraction of the window
+  // edge (ignored by the other weightings).
+  FftCorrelator(Int3 window, WindowWeighting weighting, double gaussian_sigma = 0.25);
 
   struct Scratch {
     std::unique_ptr<float, FftwFree> a, b;

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "tomorig/core/error.h"
 #include "tomorig/processing/correlation/correlate.h"
 #include "tomorig/simulators/taylor_green.h"
 #include "volume_pair.h"
@@ -105,6 +106,43 @@ TEST(Correlate, UniformSubVoxelShiftSparseInput) {
   print("uniform (0.3, -0.45, 0.2), 24^3, 1 pass + 1 deformation pass", r);
   EXPECT_LT(r.magnitude, 0.05);
   EXPECT_GT(report.valid_fraction(), 0.95);
+}
+
+// Ghost-like noise: volumes a and b each get as many extra blobs again at independent random
+// positions (uncorrelated between the exposures). On a uniform shift there is no gradient for
+// narrow weights to resolve, so the wider Gaussian, which weighs more of each window's
+// particles, must give the smaller error; and a malformed width is refused by name.
+TEST(Correlate, WiderGaussianWeightingAveragesMoreParticlesAgainstNoise) {
+  const VoxelGrid grid = test_grid(96, 96, 48);
+  const Vec3d shift{0.4, -0.3, 0.25};
+  auto truth = [&](const Vec3d&) { return shift; };
+  auto pair = make_pair(grid, 0.002, truth, 5);
+  const auto noise_a = make_pair(grid, 0.002, truth, 101), noise_b = make_pair(grid, 0.002, truth, 202);
+  for (std::size_t n = 0; n < pair.a.values.size(); ++n) {
+    pair.a.values[n] += noise_a.a.values[n];
+    pair.b.values[n] += noise_b.b.values[n];
+  }
+  auto run = [&](double sigma) {
+    CorrelationOptions options = CorrelationOptions::multigrid({24, 24, 24}, 0.5, 1);
+    options.weighting = WindowWeighting::gaussian;
+    options.gaussian_sigma = sigma;
+    CorrelationReport report;
+    return rms_error(correlate(pair.a, pair.b, options, report), grid, truth);
+  };
+  const Rms narrow = run(0.25), wide = run(0.5);
+  print("uniform shift + uncorrelated blobs, Gaussian sigma W/4", narrow);
+  print("uniform shift + uncorrelated blobs, Gaussian sigma W/2", wide);
+  EXPECT_LT(wide.magnitude, 0.8 * narrow.magnitude);
+  CorrelationOptions bad = CorrelationOptions::multigrid({24, 24, 24}, 0.5, 1);
+  bad.gaussian_sigma = 0.0;
+  CorrelationReport report;
+  try {
+    correlate(pair.a, pair.b, bad, report);
+    ADD_FAILURE() << "gaussian_sigma 0 was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::bad_input);
+    EXPECT_NE(std::string(e.what()).find("gaussian_sigma"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Correlate, LargeSubVoxelShiftWithMultigridAndDeformation) {
