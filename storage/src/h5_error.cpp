@@ -3,6 +3,16 @@
 #include <vector>
 
 namespace tomorig::storage::h5 {
+namespace {
+
+// HDF5 1.10 registers an exit handler that closes every file still open, and a file whose
+// flush failed on a full disk (which writers leave open on purpose: closing it again is what
+// fails) makes that handler crash the process after the error has been reported. tomorig
+// closes its files itself (RAII handles), so the handler has nothing else to do: it is turned
+// off before the first HDF5 call, from this file, which every HDF5 user in tomorig links.
+[[maybe_unused]] const herr_t kExitHandlerOff = H5dont_atexit();
+
+}  // namespace
 
 void silence_errors() {
   thread_local bool silenced = false;

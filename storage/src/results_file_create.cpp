@@ -128,7 +128,8 @@ void create_new_file(const fs::path& path, const ResultsInfo& info, const std::s
 
 // Room to write `bytes` more into `file` (whose current size is `size`): the free space of its
 // file system, and the process's file-size limit. Failing this check before HDF5 writes anything
-// matters: HDF5 1.10 cannot close a file whose metadata it failed to flush, and crashes at exit.
+// matters: HDF5 1.10 cannot close a file whose metadata it failed to flush (the writer then
+// abandons it; h5_error.cpp keeps HDF5's exit handler from crashing on it).
 void require_room(const fs::path& file, std::uintmax_t size, std::uintmax_t bytes, const std::string& what) {
   std::uintmax_t room = std::numeric_limits<std::uintmax_t>::max();
   struct statvfs fs_info {};

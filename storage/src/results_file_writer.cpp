@@ -105,6 +105,7 @@ struct ResultsWriter::Impl {
   void write_sidecar();
   void abandon_after_failure() noexcept;
   bool abandoned = false;  // a write failed: never append to that file in place again
+  std::function<void()> after_room_check;  // ResultsWriterOptions: a test's disk filler
 };
 
 // Creates the file under `path` through "<path>.partial" and a rename; with `copy_from`, the
@@ -263,6 +264,7 @@ ResultsWriter::ResultsWriter(const fs::path& path, const ResultsInfo& info, cons
   Impl& m = *impl_;
   m.path = path;
   m.info = info;
+  m.after_room_check = options.after_room_check;
   m.info.software_version = software_version();
   m.created_utc = utc_now_iso8601();
   m.stats = EnsembleAccumulator(info.voxel_size_mm);
@@ -351,6 +353,7 @@ void ResultsWriter::add(const SetResult& given) {
       m.write_failed(e.what());
     }
   }
+  if (m.after_room_check) m.after_room_check();
   EnsembleAccumulator updated = m.stats;
   updated.add(*set);
   h5::silence_errors();

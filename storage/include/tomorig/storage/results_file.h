@@ -17,6 +17,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -87,6 +88,9 @@ double velocity_m_per_s(double voxels, double voxel_size_mm, std::int64_t dt_ns)
 
 struct ResultsWriterOptions {
   bool overwrite = false;  // start afresh even if the file exists (else: resume it)
+  // For tests: called in add() after the room check and before HDF5 writes the set, where a
+  // test makes the disk fill up as another program would.
+  std::function<void()> after_room_check;
 };
 
 class ResultsWriter {
