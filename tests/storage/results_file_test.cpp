@@ -352,7 +352,9 @@ TEST(ResultsFile, SigkillMidAppendKeepsEveryFinishedSet) {
     while (read(fds[0], &done, 1) == 1) ++finished;  // sets it finished before the signal landed
     close(fds[0]);
     ASSERT_TRUE(WIFSIGNALED(status)) << "the writer failed by itself, status " << status;
-    ASSERT_EQ(finished, static_cast<std::uint64_t>(round));
+    // The child may finish a set or two more between the parent's last read and the signal
+    // (a loaded machine); every one it reported must be in the file.
+    ASSERT_GE(finished, static_cast<std::uint64_t>(round));
 
     const ResultsReader r(path);  // opens although its writer died
     const auto indices = r.set_indices();
