@@ -18,14 +18,14 @@ namespace {
 // unless voxel i lies in the image span and in a reachable cell.
 struct SegmentPass {
   const float *u0, *du, *v0, *dv;
-  int segments, step, nx;
+  int segments, step;
   const std::uint32_t* bits;
   int stride;
   float u_max, v_max;
   float *u, *v;
   std::uint32_t* reachable;
 
-  // Voxel i belongs to segment min(i / step, segments - 1): the last one runs on to nx.
+  // Voxel i belongs to segment min(i / step, segments - 1): the last one runs on to the row's end.
   int segment_of(int i) const { return std::min(i / step, segments - 1); }
 };
 
@@ -306,7 +306,7 @@ SupportScanner::CoarseRow SupportScanner::coarse_row(int big_j, int big_k, Row& 
     }
     const ThresholdedImage& im = images_[c];
     const int step = projector_.step(c) / 2;
-    SegmentPass pass{u0, du, v0, dv, segments, step, static_cast<int>(blocks), coarse_[c].bits.data(), im.stride,
+    SegmentPass pass{u0, du, v0, dv, segments, step, coarse_[c].bits.data(), im.stride,
                      static_cast<float>(im.width) - 0.5f, static_cast<float>(im.height) - 0.5f, row.coarse_u.data(),
                      row.coarse_v.data(), mask};
     reach_pass<true>(pass, first, last);
@@ -348,7 +348,7 @@ int SupportScanner::scan(int j, int k, Row& row) const {
     const ThresholdedImage& im = images_[c];
     float* uc = row.u.data() + c * nx;
     float* vc = row.v.data() + c * nx;
-    SegmentPass pass{row.u0.data(), row.du.data(), row.v0.data(), row.dv.data(), 0, projector_.step(c), nx_,
+    SegmentPass pass{row.u0.data(), row.du.data(), row.v0.data(), row.dv.data(), 0, projector_.step(c),
                      im.reach_bits.data(), im.stride, static_cast<float>(im.width) - 0.5f,
                      static_cast<float>(im.height) - 0.5f, uc, vc, reachable};
     pass.segments = projector_.row_segments(c, j, k, row.u0.data(), row.du.data(), row.v0.data(), row.dv.data());

@@ -99,7 +99,7 @@ class SupportScanner {
     std::vector<std::uint64_t> tested;
     std::uint64_t reached = 0;
     // The coarse test's results for the last kCoarseRows super-rows (slot K % kCoarseRows),
-    // with their (J, K) keys, and its scratch: block-centre positions, four rows' segments.
+    // with their (J, K) keys, and its scratch: block-centre positions, the centre line's segments.
     std::vector<std::uint32_t> coarse, coarse_voxels;  // per slot: per block, and spread to the voxels
     std::vector<long long> coarse_key;
     std::vector<int> coarse_span;  // per slot: first and last + 1 voxel that may be a survivor

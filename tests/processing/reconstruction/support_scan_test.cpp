@@ -52,7 +52,7 @@ std::vector<std::uint32_t> per_voxel_support(const recon::detail::PreparedInput&
   std::vector<recon::detail::ThresholdedImage> images;
   for (const recon::detail::CameraImage& im : in.images) images.emplace_back(im, threshold);
   std::vector<float> u(static_cast<std::size_t>(g.nx)), v(static_cast<std::size_t>(g.nx));
-  std::vector<char> lit(g.voxel_count(), 1);
+  std::vector<int> lit(g.voxel_count(), 1);
   for (std::size_t c = 0; c < in.camera_count(); ++c)
     for (int k = 0; k < g.nz; ++k)
       for (int j = 0; j < g.ny; ++j) {
