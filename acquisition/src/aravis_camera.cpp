@@ -23,7 +23,7 @@ namespace {
 using detail::GErrorSlot;
 using detail::GObjectPtr;
 
-constexpr guint64 kPopTimeoutUs = 100'000;  // how often the delivery thread checks for stop()
+constexpr guint64 kPopTimeoutUs = 50'000;  // how often the delivery thread checks for stop() and lost frames
 
 // Sample type of the pixel formats tomorig stores; nullopt for packed or colour formats.
 std::optional<SampleType> sample_type_of_arv(ArvPixelFormat format) {
@@ -150,6 +150,8 @@ void AravisCamera::Impl::check_unanswered() {
                                   waited / 1'000'000, options.frame_timeout.count()));
 }
 
+// The trigger counts from when it was asked for: a camera that died stops answering the
+// command itself, and the watch must not wait for the command's own timeouts.
 bool AravisCamera::Impl::send_trigger() {
   GErrorSlot error;
   arv_camera_software_trigger(camera.get(), error.out());
@@ -157,7 +159,6 @@ bool AravisCamera::Impl::send_trigger() {
     mark_disconnected(fmt::format("TriggerSoftware failed: {}", error.message()));
     return false;
   }
-  trigger_taken();
   return true;
 }
 
@@ -440,6 +441,7 @@ void AravisCamera::stop() {
 
 void AravisCamera::software_trigger() {
   if (!impl_->camera) throw runtime_error(fmt::format("camera {}: software trigger before configure()", impl_->id));
+  impl_->trigger_taken();
   if (!impl_->send_trigger())
     throw runtime_error(fmt::format("camera {}: {}", impl_->id, connection_problem()));
 }
@@ -447,6 +449,7 @@ void AravisCamera::software_trigger() {
 void AravisCamera::request_software_trigger() {
   if (!impl_->running) throw runtime_error(fmt::format("camera {}: software trigger requested before start()", impl_->id));
   if (impl_->disconnected) return;
+  impl_->trigger_taken();
   {
     std::lock_guard lock(impl_->trigger_mutex);
     ++impl_->triggers_requested;

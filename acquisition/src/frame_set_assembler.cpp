@@ -277,6 +277,11 @@ std::size_t FrameSetAssembler::queued() const {
   return queue_.size();
 }
 
+std::size_t FrameSetAssembler::pending() const {
+  std::lock_guard lock(mutex_);
+  return pending_.size();
+}
+
 AssemblyStatistics FrameSetAssembler::statistics() const {
   std::lock_guard lock(mutex_);
   return stats_;

@@ -133,6 +133,9 @@ void run(const RunOptions& opt) {
 
   // Builds, configures and arms everything: a bad rig fails here, before a file exists.
   RigAcquisition rig_run(rig, acquisition);
+  // The status socket too: an --status it refuses must not leave a .partial file behind.
+  zmq::context_t context(1);
+  StatusReporter status("recording", context, opt.rig.status);
 
   storage::SessionInfo info;
   info.cameras = rig_run.session_cameras();
@@ -158,7 +161,6 @@ void run(const RunOptions& opt) {
                             : std::string());
   std::fflush(stdout);
 
-  zmq::context_t context(1);
   stream::SocketOptions pull;
   pull.endpoint = {kInprocEndpoint, /*bind=*/true, false};
   pull.timeout = 250ms;
@@ -166,7 +168,6 @@ void run(const RunOptions& opt) {
   stream::SocketOptions push = pull;
   push.endpoint.bind = false;
   stream::FrameSender sender(context, push);
-  StatusReporter status("recording", context, opt.rig.status);
   if (!status.endpoint().empty()) fmt::print(stderr, "run: status JSON on {}\n", status.endpoint());
 
   // Ctrl-C ends the run between sets: acquisition stops, the sets already taken are recorded,
@@ -181,11 +182,16 @@ void run(const RunOptions& opt) {
   figures.total = acquisition.sets;
   std::string stopped_by;
   std::string disk_full;
+  const std::filesystem::path out_folder = out.has_parent_path() ? out.parent_path() : std::filesystem::path(".");
   auto refresh = [&](bool final) {
     const RigProgress progress = rig_run.progress();
-    const std::uint64_t in_stream = sender.stats().sets_sent - receiver.stats().sets_received;
-    figures.queue_depth = progress.queued_sets + in_stream;
-    figures.dropped_trigger_events = progress.dropped_trigger_events;
+    // Received first: a set sent after that read cannot make the difference negative.
+    const std::uint64_t received = receiver.stats().sets_received;
+    figures.queue_depth = progress.queued_sets + sets_in_flight(sender.stats().sets_sent, received);
+    take_progress(figures, progress);
+    std::error_code ec;
+    const auto space = std::filesystem::space(out_folder, ec);
+    if (!ec) figures.disk_free_bytes = space.available;
     status.update(figures, losses, final);
   };
   for (;;) {
@@ -251,6 +257,15 @@ void run(const RunOptions& opt) {
                                     figures.sets));
   if (!rig_run.failure().empty())
     throw runtime_error(fmt::format("{}; {} is complete with {} sets", rig_run.failure(), out.string(), figures.sets));
+  // Every set flagged is a run that did not work, whatever was written (a wrong frame_mode,
+  // cameras not answering the trigger): it must not look like success. Free-running cameras
+  // make no set complete by design and are warned about on every status line instead.
+  bool free_running = false;
+  for (const auto& cam : rig.cameras) free_running |= cam.frame_mode == config::FrameMode::free_run;
+  if (figures.sets > 0 && losses.incomplete_sets() == figures.sets && !free_running && stopped_by.empty())
+    throw runtime_error(fmt::format("none of the {} sets is complete ({} lost frames); {} keeps them, flagged. Check "
+                                    "the cameras' frame_mode and the messages above",
+                                    figures.sets, losses.frames_lost(), out.string()));
   if (!stopped_by.empty())
     fmt::print(stderr, "stopped by {} after {} sets; the session is complete\n", stopped_by, figures.sets);
 }

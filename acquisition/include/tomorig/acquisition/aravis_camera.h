@@ -36,7 +36,7 @@ struct AravisCameraOptions {
   // A trigger the camera took whose frame has not begun to arrive this long after marks the
   // camera disconnected (the camera, its cable or its stream is gone), as does the Aravis
   // "control-lost" signal and a trigger command that fails.
-  std::chrono::milliseconds frame_timeout{500};
+  std::chrono::milliseconds frame_timeout{400};
   int packet_size = 0;                      // GigE GevSCPSPacketSize in bytes; 0: camera's value
   int socket_buffer_bytes = 0;              // GigE receive socket buffer; 0: Aravis default
   // GigE: how long an incomplete frame waits for missing packets before it fails (Aravis

@@ -105,6 +105,8 @@ class FrameSetAssembler {
   // Waits up to `wait` (real time) for the next set, expiring timed-out sets meanwhile.
   std::optional<FrameSet> pop(std::chrono::milliseconds wait);
   std::size_t queued() const;
+  // Sets still being assembled (not yet emitted).
+  std::size_t pending() const;
 
   AssemblyStatistics statistics() const;
   const AssemblerOptions& options() const { return options_; }

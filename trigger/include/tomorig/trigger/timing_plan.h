@@ -66,12 +66,12 @@ struct ChannelSpec {
 
 // The camera's double-frame timing (identical cameras; per-camera latency is ChannelSpec::delay_ns).
 struct CameraTiming {
-  FrameMode mode = FrameMode::hardware;
   std::int64_t exposure_a_ns = 20'000;    // frame A exposure, set on the camera (two_triggers: both frames)
   std::int64_t interframe_ns = 120;       // hardware: blind time between frames A and B (sCMOS: ~120 ns)
   std::int64_t exposure_b_ns = 1'000'000; // hardware: frame B lasts until frame A is read out
   std::int64_t readout_ns = 0;            // two_triggers: least time from the end of an exposure
                                           // to the next trigger the camera takes (> 0)
+  FrameMode mode = FrameMode::hardware;
 };
 
 struct TimingInputs {
