@@ -15,6 +15,7 @@
 #include "genicam_features.h"
 #include "glib_handles.h"
 #include "tomorig/acquisition/frame_id.h"
+#include "tomorig/acquisition/trigger_matcher.h"
 #include "tomorig/core/error.h"
 
 namespace tomorig::acquisition {
@@ -80,10 +81,17 @@ struct AravisCamera::Impl {
 
   // The trigger thread sends queued TriggerSoftware commands, so a dead camera (whose every
   // command waits for GVCP timeouts) never holds up the rig loop or the other cameras.
+  struct TriggerJob {
+    std::optional<std::uint64_t> event;  // nullopt: warm-up, one trigger, its frames discarded
+    std::int64_t spacing_ns = 0;         // two_triggers: frame B's trigger after frame A's
+  };
   std::mutex trigger_mutex;
   std::condition_variable trigger_wanted;
-  int triggers_requested = 0;
+  std::deque<TriggerJob> trigger_jobs;
   std::thread trigger_thread;
+  // Software triggers: which trigger each frame answers, by time (null: frames are counted).
+  std::unique_ptr<TriggerMatcher> matcher;
+  std::atomic<std::uint64_t> unmatched{0};
 
   std::shared_ptr<detail::AravisBufferPool> pool;  // kept after stop() so statistics stay readable
   mutable std::mutex pool_mutex;  // guards the `pool` pointer for statistics() (sinks may call it)
@@ -162,15 +170,29 @@ bool AravisCamera::Impl::send_trigger() {
   return true;
 }
 
+// One job per trigger event: frame A's trigger, and for two_triggers frame B's, spaced from
+// when A's was really sent (not when it was asked for), so a busy host delays both alike.
 void AravisCamera::Impl::trigger_loop() {
   for (;;) {
+    TriggerJob job;
     {
       std::unique_lock lock(trigger_mutex);
-      trigger_wanted.wait(lock, [&] { return triggers_requested > 0 || !running; });
+      trigger_wanted.wait(lock, [&] { return !trigger_jobs.empty() || !running; });
       if (!running) return;
-      --triggers_requested;
+      job = trigger_jobs.front();
+      trigger_jobs.pop_front();
     }
-    if (!disconnected) send_trigger();
+    const int triggers = job.event && options.frame_mode == config::FrameMode::two_triggers ? 2 : 1;
+    std::int64_t frame_a_sent = 0;
+    for (int k = 0; k < triggers && !disconnected && running; ++k) {
+      if (k == 1)
+        std::this_thread::sleep_until(std::chrono::steady_clock::time_point(std::chrono::nanoseconds(frame_a_sent + job.spacing_ns)));
+      const std::int64_t now = steady_ns();
+      if (k == 0) frame_a_sent = now;
+      if (matcher) matcher->expect({job.event, k == 0 ? Exposure::A : Exposure::B, now});
+      trigger_taken();
+      send_trigger();
+    }
   }
 }
 
@@ -319,6 +341,17 @@ void AravisCamera::Impl::deliver(ArvBuffer* buffer, FrameIdUnwrapper& unwrapper)
   frame.trigger_index = *sequence / 2;
   frame.exposure = *sequence % 2 == 0 ? Exposure::A : Exposure::B;
   frame.timestamp_ns = static_cast<std::int64_t>(arv_buffer_get_timestamp(buffer));
+  if (matcher) {
+    // The camera numbers frames, not events: the trigger it answers is found by time.
+    const auto hit = matcher->match(*sequence, frame.timestamp_ns);
+    if (!hit || !hit->event) {  // a warm-up frame, or one no trigger explains
+      if (!hit) ++unmatched;
+      pool->give_back(buffer);
+      return;
+    }
+    frame.trigger_index = *hit->event;
+    frame.exposure = hit->exposure;
+  }
   frame.image = Image::view(const_cast<void*>(data), width, height, *type, 0, pool->lease(buffer));
   ++delivered;
   sink(std::move(frame));
@@ -409,7 +442,14 @@ void AravisCamera::start(FrameSink sink) {
     impl_->unanswered_triggers.clear();
     impl_->triggers_taken = impl_->triggers_answered = 0;
   }
-  impl_->triggers_requested = 0;
+  impl_->trigger_jobs.clear();
+  impl_->unmatched = 0;
+  if (impl_->options.trigger_source == "Software" && impl_->options.match_tolerance_ns > 0 &&
+      impl_->options.frame_mode != config::FrameMode::free_run)
+    impl_->matcher = std::make_unique<TriggerMatcher>(frames_per_trigger(impl_->options.frame_mode),
+                                                      impl_->options.match_tolerance_ns);
+  else
+    impl_->matcher.reset();
   impl_->running = true;
   impl_->delivery = std::thread([impl = impl_.get()] { impl->deliver_loop(); });
   impl_->trigger_thread = std::thread([impl = impl_.get()] { impl->trigger_loop(); });
@@ -446,16 +486,17 @@ void AravisCamera::software_trigger() {
     throw runtime_error(fmt::format("camera {}: {}", impl_->id, connection_problem()));
 }
 
-void AravisCamera::request_software_trigger() {
+void AravisCamera::request_software_trigger(std::optional<std::uint64_t> event, std::int64_t spacing_ns) {
   if (!impl_->running) throw runtime_error(fmt::format("camera {}: software trigger requested before start()", impl_->id));
   if (impl_->disconnected) return;
-  impl_->trigger_taken();
   {
     std::lock_guard lock(impl_->trigger_mutex);
-    ++impl_->triggers_requested;
+    impl_->trigger_jobs.push_back({event, spacing_ns});
   }
   impl_->trigger_wanted.notify_one();
 }
+
+std::uint64_t AravisCamera::frames_unmatched() const { return impl_->unmatched; }
 
 void AravisCamera::note_hardware_trigger() { impl_->trigger_taken(); }
 

@@ -138,6 +138,15 @@ RigAcquisition::RigAcquisition(const config::RigConfig& rig, RigAcquisitionOptio
       aravis.frame_mode = cam.frame_mode;
       if (software_triggers_) aravis.trigger_source = "Software";
       aravis.exposure_time_us = static_cast<double>(plan_.camera.exposure_a_ns) / 1000.0;
+      if (software_triggers_) {
+        // Frames answer triggers a period apart (hardware) or Δt and the rest of the period
+        // apart (two_triggers): half the closer spacing tells them apart.
+        const std::int64_t separation = plan_.frame_separation_ns();
+        const std::int64_t closest = cam.frame_mode == config::FrameMode::two_triggers
+                                         ? std::min(separation, plan_.period_ns - separation)
+                                         : plan_.period_ns;
+        aravis.match_tolerance_ns = closest / 2;
+      }
       auto camera = std::make_unique<acquisition::AravisCamera>(cam.id, aravis);
       camera->configure(cam);  // an absent camera or a refused feature is named here
       session_cameras_.push_back({cam.id, cam.roi.width, cam.roi.height, cam.pixel_format, cam.pixel_pitch_um});
@@ -161,22 +170,28 @@ RigAcquisition::~RigAcquisition() {
 
 void RigAcquisition::start() {
   for (std::size_t c = 0; c < cameras_.size(); ++c)
-    cameras_[c]->start([this, c](acquisition::CameraFrame&& frame) {
-      if (software_triggers_ && !free_running_[c]) {
-        // The camera numbers its sets by the triggers it took; the loop knows their events.
-        const auto event = event_of_triggered_set(frame.trigger_index);
-        frame.trigger_index = event ? *event : std::numeric_limits<std::uint64_t>::max();  // rejected: no such trigger
-      }
-      assembler_->add_frame(c, std::move(frame));
-    });
+    cameras_[c]->start([this, c](acquisition::CameraFrame&& frame) { assembler_->add_frame(c, std::move(frame)); });
+  warm_up_cameras();
   device_->start(options_.sets);
   worker_ = std::thread([this] { loop(); });
 }
 
-std::optional<std::uint64_t> RigAcquisition::event_of_triggered_set(std::uint64_t ordinal) const {
-  std::lock_guard lock(triggered_mutex_);
-  if (ordinal >= triggered_events_.size()) return std::nullopt;
-  return triggered_events_[ordinal];
+// Some cameras take their first trigger after AcquisitionStart late or not at all (Aravis's
+// GigE fake looks for it only every 100 ms until it has sent a frame, so a second trigger
+// 60 ms later is lost). One trigger before the run, whose frame is discarded, makes every
+// software-triggered camera ready and gives its frame matcher a first frame to measure from.
+void RigAcquisition::warm_up_cameras() {
+  if (!software_triggers_) return;
+  std::vector<std::size_t> warming;
+  for (std::size_t c = 0; c < aravis_cameras_.size(); ++c) {
+    if (free_running_[c]) continue;
+    aravis_cameras_[c]->request_software_trigger(std::nullopt);
+    warming.push_back(c);
+  }
+  const auto give_up = Clock::now() + std::chrono::seconds(1);
+  for (const std::size_t c : warming)
+    while (aravis_cameras_[c]->statistics().delivered == 0 && aravis_cameras_[c]->connected() && Clock::now() < give_up)
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
 }
 
 void RigAcquisition::request_stop() { stop_requested_ = true; }
@@ -254,22 +269,11 @@ void RigAcquisition::trigger_aravis_cameras(std::uint64_t index, std::int64_t dt
       if (!free_running_[c] && aravis_cameras_[c]->connected()) aravis_cameras_[c]->note_hardware_trigger();
     return;
   }
-  const auto frame_a = Clock::now();
-  {
-    std::lock_guard lock(triggered_mutex_);
-    triggered_events_.push_back(index);
-  }
-  bool second_trigger = false;
-  for (std::size_t c = 0; c < aravis_cameras_.size(); ++c) {
-    if (free_running_[c] || !aravis_cameras_[c]->connected()) continue;
-    aravis_cameras_[c]->request_software_trigger();
-    second_trigger |= aravis_cameras_[c]->triggers_per_set() == 2;
-  }
-  if (!second_trigger) return;
-  std::this_thread::sleep_until(frame_a + std::chrono::nanoseconds(plan_.frame_separation_ns() + dt_ns - plan_.dt_ns));
+  // Frame B's trigger (two_triggers) follows A's by the plan's separation plus this event's
+  // Δt error; each camera's trigger thread times it from when its A trigger really went out.
+  const std::int64_t spacing = plan_.frame_separation_ns() + dt_ns - plan_.dt_ns;
   for (std::size_t c = 0; c < aravis_cameras_.size(); ++c)
-    if (!free_running_[c] && aravis_cameras_[c]->triggers_per_set() == 2 && aravis_cameras_[c]->connected())
-      aravis_cameras_[c]->request_software_trigger();
+    if (!free_running_[c] && aravis_cameras_[c]->connected()) aravis_cameras_[c]->request_software_trigger(index, spacing);
 }
 
 void RigAcquisition::report_mismatches() {

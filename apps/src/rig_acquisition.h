@@ -130,8 +130,7 @@ class RigAcquisition {
   void report_mismatches();
   void finish_run();
   void notice(std::string text);
-  // The event a software-triggered camera's k-th set of frames answers (nullopt: none).
-  std::optional<std::uint64_t> event_of_triggered_set(std::uint64_t ordinal) const;
+  void warm_up_cameras();
 
   config::RigConfig rig_;
   RigAcquisitionOptions options_;
@@ -151,11 +150,7 @@ class RigAcquisition {
   // Dropped trigger events not yet announced to the assembler, oldest first.
   std::vector<trigger::TriggerEvent> dropped_;
 
-  // Software triggers: the trigger events the cameras were fired for, in order. The cameras
-  // count their frames; the k-th pair answers triggered_events_[k] (a dropped event fired no
-  // camera, so it has no entry and its set stays empty).
-  mutable std::mutex triggered_mutex_;
-  std::vector<std::uint64_t> triggered_events_;
+
 
   // The frames the simulator rendered for the event being handled, by camera id; the simulated
   // cameras' renderers take them from here (same thread).

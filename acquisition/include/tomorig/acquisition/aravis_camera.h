@@ -37,6 +37,10 @@ struct AravisCameraOptions {
   // camera disconnected (the camera, its cable or its stream is gone), as does the Aravis
   // "control-lost" signal and a trigger command that fails.
   std::chrono::milliseconds frame_timeout{400};
+  // Software triggers: frames are matched to the trigger (and event) they answer by time
+  // (TriggerMatcher) within this tolerance, below half the closest spacing of two triggers;
+  // 0: frames are counted instead (frame k of the stream is set k / 2 since start).
+  std::int64_t match_tolerance_ns = 0;
   int packet_size = 0;                      // GigE GevSCPSPacketSize in bytes; 0: camera's value
   int socket_buffer_bytes = 0;              // GigE receive socket buffer; 0: Aravis default
   // GigE: how long an incomplete frame waits for missing packets before it fails (Aravis
@@ -79,10 +83,14 @@ class AravisCamera final : public Camera {
   // Sends one TriggerSoftware command (for trigger_source = "Software") and waits for the
   // camera's answer. Throws runtime_error (and marks the camera disconnected) if it fails.
   void software_trigger();
-  // Queues one TriggerSoftware command for the camera's trigger thread and returns at once,
-  // so a camera that stopped answering cannot hold up the others. Ignored once disconnected.
-  // Needs start().
-  void request_software_trigger();
+  // Queues the TriggerSoftware commands of trigger event `event` for the camera's trigger
+  // thread and returns at once, so a camera that stopped answering cannot hold up the others:
+  // one (hardware), or two `spacing_ns` apart from when the first was sent (two_triggers).
+  // With match_tolerance_ns its frames carry `event` as trigger index. nullopt: one warm-up
+  // trigger whose frames are discarded. Ignored once disconnected. Needs start().
+  void request_software_trigger(std::optional<std::uint64_t> event, std::int64_t spacing_ns = 0);
+  // Frames no trigger explained (matching by time), discarded.
+  std::uint64_t frames_unmatched() const;
   // Tells the camera a hardware trigger line fired for it, so a frame that never comes is
   // noticed (frame_timeout).
   void note_hardware_trigger();
