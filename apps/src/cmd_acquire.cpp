@@ -2,6 +2,12 @@
 // assembly as in `tomorig run`, but the sets leave over the lossless ZeroMQ stream (PUSH) for a
 // `tomorig record` in another process, possibly on another host. It binds by default (the
 // recorder connects); a full recorder slows acquisition down (back-pressure), it never drops.
+//
+// The stream carries the session as well as the sets: a session start (rig file, cameras with
+// pixel pitch, the simulator's truth) goes out first, and the rig only starts once a recorder
+// has taken it; each simulated set's truth goes just before the set; an end-of-acquisition
+// message closes the session, so the recorder writes what `tomorig run` writes and stops by
+// itself.
 #include <cerrno>
 #include <chrono>
 #include <memory>
@@ -16,6 +22,7 @@
 #include "record_layout.h"
 #include "rig_acquisition.h"
 #include "rig_run_options.h"
+#include "rig_session_info.h"
 #include "send_with_retry.h"
 #include "rig_status.h"
 #include "stop_signal.h"
@@ -44,7 +51,8 @@ void acquire(const AcquireOptions& opt) {
     throw bad_input(fmt::format("--timeout {:g} / --wait {:g} are invalid: both must be > 0 seconds", opt.timeout_s,
                                 opt.wait_s));
   const config::RigConfig rig = load_rig(opt.rig);
-  const RigAcquisitionOptions acquisition = rig_acquisition_options(rig, opt.rig);
+  RigAcquisitionOptions acquisition = rig_acquisition_options(rig, opt.rig);
+  acquisition.keep_truth = true;  // simulated rigs: the recorder gets the truth `run` would write
   RigAcquisition rig_run(rig, acquisition);  // a bad rig fails here, before anything is sent
 
   StopSignalGuard stop;
@@ -72,6 +80,16 @@ void acquire(const AcquireOptions& opt) {
     status.update(figures, losses, final);
   };
   std::string stopped_by;
+  stream::SessionStart session;
+  session.session_id = stream::new_session_id();
+  session.info = rig_session_info(rig, rig_run);
+  session.truth = rig_run.session_truth();
+  // Waits (up to --wait) for a recorder before the trigger fires, so no set queues up
+  // unrecorded meanwhile; Ctrl-C while waiting ends the command with nothing acquired.
+  if (send_with_retry(*sender, session, opt.wait_s, &stop) == SendOutcome::stopped) {
+    fmt::print("no recorder took the session start; stopped by {} before acquiring\n", stop.signal_name());
+    return;
+  }
   rig_run.start();
   while (!rig_run.done()) {
     for (const auto& text : rig_run.take_notices()) {
@@ -88,10 +106,12 @@ void acquire(const AcquireOptions& opt) {
       refresh(false);
       continue;
     }
-    const bool first = sender->stats().sets_sent == 0;
+    if (auto truth = rig_run.take_truth(set->trigger_index))
+      send_with_retry(*sender, stream::SetTruth{session.session_id, set->trigger_index, std::move(*truth)},
+                      opt.timeout_s, nullptr);
     // Ctrl-C interrupts a wait for the recorder; the set in hand and those already acquired
     // still go out, each with the normal timeout.
-    if (send_with_retry(*sender, *set, first ? opt.wait_s : opt.timeout_s, stopped_by.empty() ? &stop : nullptr) ==
+    if (send_with_retry(*sender, *set, opt.timeout_s, stopped_by.empty() ? &stop : nullptr) ==
         SendOutcome::stopped) {
       stopped_by = stop.signal_name();
       figures.state = "stopping";
@@ -105,6 +125,19 @@ void acquire(const AcquireOptions& opt) {
   }
   for (const auto& text : rig_run.take_notices()) fmt::print(stderr, "acquire: {}\n", text);
   rig_run.request_stop();
+
+  // The end of acquisition: the recorder closes its file when it has every set sent before.
+  stream::SessionEnd end;
+  end.session_id = session.session_id;
+  end.sets_sent = sender->stats().sets_sent;
+  if (!rig_run.failure().empty()) {
+    end.outcome = stream::SessionOutcome::failed;
+    end.reason = rig_run.failure();
+  } else if (!stopped_by.empty()) {
+    end.outcome = stream::SessionOutcome::stopped;
+    end.reason = "stopped by " + stopped_by;
+  }
+  send_with_retry(*sender, end, opt.timeout_s, nullptr);
 
   // Hand every queued set to the transport: closing the context waits (up to one --timeout of
   // linger) until ZeroMQ has written them to the recorder.

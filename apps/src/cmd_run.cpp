@@ -24,11 +24,11 @@
 #include "record_layout.h"
 #include "rig_acquisition.h"
 #include "rig_run_options.h"
+#include "rig_session_info.h"
 #include "rig_status.h"
 #include "stop_signal.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
-#include "tomorig/core/version.h"
 #include "tomorig/storage/session_file.h"
 #include "tomorig/stream/frame_receiver.h"
 #include "tomorig/stream/frame_sender.h"
@@ -134,10 +134,7 @@ void run(const RunOptions& opt) {
   // Builds, configures and arms everything: a bad rig fails here, before a file exists.
   RigAcquisition rig_run(rig, acquisition);
 
-  storage::SessionInfo info;
-  info.cameras = rig_run.session_cameras();
-  info.rig_config_toml = rig.source_text;
-  info.software_version = std::string(software_version());
+  storage::SessionInfo info = rig_session_info(rig, rig_run);
   storage::SessionWriterOptions writer_options;
   writer_options.live = true;
   writer_options.compression = *compression;
@@ -213,7 +210,7 @@ void run(const RunOptions& opt) {
     losses.add(*set);
     if (!writer) {
       std::string why;
-      auto cameras = cameras_from_set(*set, why);
+      auto cameras = complete_announced_cameras(info.cameras, *set, why);
       if (!cameras) continue;  // counted in the losses; a later complete set starts the session
       info.cameras = std::move(*cameras);
       open_writer();

@@ -55,6 +55,37 @@ std::optional<std::vector<storage::SessionCamera>> cameras_from_set(const FrameS
   return cameras;
 }
 
+std::optional<std::vector<storage::SessionCamera>> complete_announced_cameras(
+    const std::vector<storage::SessionCamera>& announced, const FrameSet& set, std::string& why) {
+  bool sizes_known = true;
+  for (const auto& cam : announced) sizes_known &= cam.width > 0 && cam.height > 0;
+  if (sizes_known) return announced;
+  const auto learned = cameras_from_set(set, why);
+  if (!learned) return std::nullopt;
+  if (learned->size() != announced.size()) {
+    why = fmt::format("it has {} cameras, the session start announced {}", learned->size(), announced.size());
+    return std::nullopt;
+  }
+  std::vector<storage::SessionCamera> cameras = announced;
+  for (std::size_t i = 0; i < cameras.size(); ++i) {
+    const storage::SessionCamera& got = (*learned)[i];
+    if (got.id != cameras[i].id) {
+      why = fmt::format("camera {} is '{}', the session start announced '{}'", i, got.id, cameras[i].id);
+      return std::nullopt;
+    }
+    if (sample_type_of(got.pixel_format) != sample_type_of(cameras[i].pixel_format)) {
+      why = fmt::format("camera '{}' sends {} frames, the session start announced {}", got.id,
+                        to_string(got.pixel_format), to_string(cameras[i].pixel_format));
+      return std::nullopt;
+    }
+    if (cameras[i].width == 0 || cameras[i].height == 0) {
+      cameras[i].width = got.width;
+      cameras[i].height = got.height;
+    }
+  }
+  return cameras;
+}
+
 bool set_matches_cameras(const FrameSet& set, const std::vector<storage::SessionCamera>& cameras, std::string& why) {
   if (set.cameras.size() != cameras.size()) {
     why = fmt::format("it has {} cameras, the session {}", set.cameras.size(), cameras.size());

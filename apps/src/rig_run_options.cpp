@@ -4,6 +4,7 @@
 #include <fmt/core.h>
 
 #include "tomorig/core/error.h"
+#include "tomorig/stream/endpoint.h"
 
 namespace tomorig::app {
 namespace {
@@ -12,6 +13,23 @@ trigger::Pacing parse_pace(const std::string& text) {
   if (text == "real-time") return trigger::Pacing::real_time;
   if (text == "max") return trigger::Pacing::as_fast_as_consumed;
   throw bad_input(fmt::format("--pace {} is not supported: use real-time or max", text));
+}
+
+// The status socket binds --status. Checked with the other options, before a file is created or
+// a device armed, with advice for the command line: unlike the frame stream, the status
+// socket has no way to allow a remote bind.
+void check_status_endpoint(const std::string& address) {
+  if (address.empty() || address == "none") return;
+  try {
+    stream::check_endpoint({address, /*bind=*/true, /*allow_remote=*/true});  // the address's form only
+  } catch (const Error& e) {
+    throw bad_input(fmt::format("--status: {}", e.what()));
+  }
+  if (!stream::is_local_address(address))
+    throw bad_input(fmt::format("--status {} would publish the rig's status to other hosts; bind it to loopback "
+                                "(e.g. --status tcp://127.0.0.1:5556) or an ipc:// path, or pass --status none "
+                                "(a remote monitor connects through an SSH tunnel to the loopback port)",
+                                address));
 }
 
 }  // namespace
@@ -45,6 +63,7 @@ RigAcquisitionOptions rig_acquisition_options(const config::RigConfig& rig, cons
   const auto loss_policy = parse_camera_loss_policy(choices.on_camera_loss);
   if (!loss_policy)
     throw bad_input(fmt::format("--on-camera-loss {} is not supported: use stop or continue", choices.on_camera_loss));
+  check_status_endpoint(choices.status);
   RigAcquisitionOptions options;
   options.sets = choices.sets;
   options.duration_s = choices.duration_s;

@@ -34,7 +34,8 @@ void add_rig_run_options(CLI::App& cmd, RigRunChoices& choices, const std::strin
 config::RigConfig load_rig(const RigRunChoices& choices);
 
 // Checks the choices (bad_input naming the option: --sets < 1, an unknown --pace or
-// --on-camera-loss, a malformed --inject-fault) and fills the acquisition options. A simulated
+// --on-camera-loss, a malformed --inject-fault, a --status that is not a loopback or ipc
+// address) and fills the acquisition options. A simulated
 // rig stops after its configured number of sets unless --sets or --duration says otherwise; a
 // camera rig runs until Ctrl-C.
 RigAcquisitionOptions rig_acquisition_options(const config::RigConfig& rig, const RigRunChoices& choices);

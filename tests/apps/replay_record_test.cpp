@@ -9,6 +9,7 @@
 
 #include "child_process.h"
 #include "cli_runner.h"
+#include "session_compare.h"
 #include "tomorig/storage/session_file.h"
 
 namespace tomorig::testing {
@@ -96,6 +97,25 @@ TEST_F(ReplayRecord, RoundTripIsBitIdentical) {
   ASSERT_TRUE(std::filesystem::exists(out));
   EXPECT_FALSE(std::filesystem::exists(out.string() + ".partial"));
   EXPECT_TRUE(storage::SessionReader(out).recording_complete());
+  expect_same_sets(src, out, 3);
+}
+
+// Replay announces the session it reads, so the copy keeps /config, the attributes (creation
+// time and software version included), pixel pitch and truth, and record stops by itself
+// after the last set.
+TEST_F(ReplayRecord, CopyKeepsConfigAttributesPitchAndTruthAndEndsByItself) {
+  TempDir tmp;
+  const auto src = source();
+  const auto out = tmp / "copy.h5";
+  TomorigProcess replay({"replay", src.string(), "--to", "tcp://127.0.0.1:*", "--rate", "max"});
+  const auto first_line = replay.wait_for_line("sending on");
+  ASSERT_TRUE(first_line) << replay.err();
+  // Only the end of acquisition should end the recording (the idle timeout is a safety net).
+  TomorigProcess record({"record", "--from", endpoint_from(*first_line), "-o", out.string(), "--idle-timeout", "120"});
+  ASSERT_EQ(record.wait(), 0) << record.err();
+  ASSERT_EQ(replay.wait(), 0) << replay.err();
+  EXPECT_NE(record.out().find("the sender ended the session: completed"), std::string::npos) << record.out();
+  expect_same_session_metadata(src, out, /*same_creation_time=*/true);
   expect_same_sets(src, out, 3);
 }
 
