@@ -137,7 +137,13 @@ void acquire(const AcquireOptions& opt) {
     end.outcome = stream::SessionOutcome::stopped;
     end.reason = "stopped by " + stopped_by;
   }
-  send_with_retry(*sender, end, opt.timeout_s, nullptr);
+  try {
+    send_with_retry(*sender, end, opt.timeout_s, nullptr);
+  } catch (const Error& e) {
+    if (stopped_by.empty()) throw;
+    // Stopped by the operator, typically after the recorder: nobody is left to tell.
+    fmt::print(stderr, "acquire: {}\n", e.what());
+  }
 
   // Hand every queued set to the transport: closing the context waits (up to one --timeout of
   // linger) until ZeroMQ has written them to the recorder.

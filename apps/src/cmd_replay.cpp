@@ -132,7 +132,13 @@ void replay(const ReplayOptions& opt) {
       end.outcome = stream::SessionOutcome::stopped;
       end.reason = fmt::format("replay stopped by {}", stop.signal_name());
     }
-    send_with_retry(*sender, end, opt.timeout_s, nullptr);
+    try {
+      send_with_retry(*sender, end, opt.timeout_s, nullptr);
+    } catch (const Error& e) {
+      if (!stopped) throw;
+      // Stopped by the operator, typically after the recorder: nobody is left to tell.
+      fmt::print(stderr, "replay: {}\n", e.what());
+    }
   }
 
   // Hand every queued set to the transport: closing the context waits (up to the linger, one

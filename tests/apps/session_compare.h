@@ -33,7 +33,9 @@ inline void expect_same_session_metadata(const std::filesystem::path& want_path,
   EXPECT_EQ(b.compression, a.compression);
   EXPECT_EQ(got.format_version(), want.format_version());
   EXPECT_EQ(got.recording_complete(), want.recording_complete());
-  if (same_creation_time) EXPECT_EQ(b.created_utc, a.created_utc);
+  if (same_creation_time) {
+    EXPECT_EQ(b.created_utc, a.created_utc);
+  }
   ASSERT_EQ(b.cameras.size(), a.cameras.size());
   for (std::size_t c = 0; c < a.cameras.size(); ++c) {
     EXPECT_EQ(b.cameras[c].id, a.cameras[c].id);
