@@ -3,6 +3,8 @@
 // next to a memcpy of the same bytes measured in the same run (issues 6 and 13,
 // docs/performance.md). Sender and receiver have a ZeroMQ context each over tcp and ipc, as
 // two processes would; CPU time is the whole process's, both sides included.
+#include <sys/resource.h>
+
 #include <chrono>
 #include <cstring>
 #include <string>
@@ -53,6 +55,13 @@ double memcpy_mb_per_s(const FrameSet& set, int repeats) {
   return static_cast<double>(set_bytes(set)) * repeats / seconds / 1e6;
 }
 
+// Page faults the process took so far (receive buffers faulted in show up here).
+long minor_page_faults() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_minflt;
+}
+
 std::string bench_address(const std::string& transport) {
   if (transport == "tcp") return "tcp://127.0.0.1:*";
   if (transport == "ipc") return "ipc://*";  // ZeroMQ picks a fresh socket file
@@ -90,11 +99,13 @@ nlohmann::json stream_run(const FrameSet& set, const std::string& transport, con
   for (; received < args.warmup_sets; ++received)
     if (!receiver.receive()) break;
   const double cpu0 = process_cpu_seconds();
+  const long faults0 = minor_page_faults();
   const auto start = Clock::now();
   for (; received < total; ++received)
     if (!receiver.receive()) break;
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   const double cpu = process_cpu_seconds() - cpu0;
+  const long faults = minor_page_faults() - faults0;
   producer.join();
   if (send_failed || received < total)
     throw runtime_error(fmt::format("bench stream over {}: only {} of {} sets arrived", transport, received, total));
@@ -107,6 +118,7 @@ nlohmann::json stream_run(const FrameSet& set, const std::string& transport, con
           {"cpu_seconds", cpu},
           {"gb_per_cpu_second", cpu > 0 ? bytes / cpu / 1e9 : 0.0},
           {"cpu_seconds_per_gb", bytes > 0 ? cpu / (bytes / 1e9) : 0.0},
+          {"page_faults_per_gb", bytes > 0 ? static_cast<double>(faults) / (bytes / 1e9) : 0.0},
           {"sets_missing", receiver.stats().sets_missing},
           {"blocked_sends", sender.stats().blocked_sends}};
 }
@@ -127,9 +139,9 @@ void run(const BenchStreamArgs& args) {
   for (const std::string& t : args.transports) {
     nlohmann::json r = stream_run(set, t, args);
     r["ratio_to_memcpy"] = r["mb_per_s"].get<double>() / memcpy_rate;
-    fmt::print(stderr, "  {:6} {:8.0f} MB/s  {:6.1f} sets/s  ({:.3f} of memcpy)  {:.3f} CPU-s per GB\n", t,
-               r["mb_per_s"].get<double>(), r["sets_per_s"].get<double>(), r["ratio_to_memcpy"].get<double>(),
-               r["cpu_seconds_per_gb"].get<double>());
+    fmt::print(stderr, "  {:6} {:8.0f} MB/s  {:6.1f} sets/s  ({:.3f} of memcpy)  {:.3f} CPU-s per GB  {:.0f} page faults per GB\n",
+               t, r["mb_per_s"].get<double>(), r["sets_per_s"].get<double>(), r["ratio_to_memcpy"].get<double>(),
+               r["cpu_seconds_per_gb"].get<double>(), r["page_faults_per_gb"].get<double>());
     results.push_back(std::move(r));
   }
   // The thesis rig: 4 sCMOS x 2560 x 2160 x 2 exposures x 2 bytes at 25 Hz.
