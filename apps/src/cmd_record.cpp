@@ -16,13 +16,19 @@
 #include <zmq.hpp>
 
 #include "commands.h"
-#include "record_layout.h"
-#include "stop_signal.h"
+#include "tomorig/rig/record_layout.h"
+#include "tomorig/rig/stop_signal.h"
 #include "tomorig/core/error.h"
 #include "tomorig/storage/session_file.h"
 #include "tomorig/stream/frame_receiver.h"
 
 namespace tomorig::app {
+
+using rig::StopSignalGuard;
+using rig::cameras_from_set;
+using rig::set_matches_cameras;
+using rig::pixel_bytes;
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
