@@ -1,0 +1,90 @@
+#include "histogram_stats.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace tomorig::quicklook::detail {
+namespace {
+
+// One-sided normal tail beyond 1 sigma over the half: P(Z < -1) / P(Z < 0).
+constexpr double kOneSigmaOfHalf = 0.158655253931457 / 0.5;
+
+}  // namespace
+
+double quantile(std::span<const std::uint32_t> histogram, double total, double p) {
+  const double target = std::clamp(p, 0.0, 1.0) * total;
+  double cumulative = 0;
+  for (std::size_t v = 0; v < histogram.size(); ++v) {
+    cumulative += histogram[v];
+    if (cumulative >= target && histogram[v] > 0) return static_cast<double>(v);
+  }
+  return static_cast<double>(histogram.size() - 1);
+}
+
+double quantile_continuous(std::span<const std::uint32_t> histogram, double total, double p) {
+  const double target = std::clamp(p, 0.0, 1.0) * total;
+  double before = 0;
+  for (std::size_t v = 0; v < histogram.size(); ++v) {
+    const double h = histogram[v];
+    if (h > 0 && before + h >= target) return static_cast<double>(v) - 0.5 + (target - before) / h;
+    before += h;
+  }
+  return static_cast<double>(histogram.size()) - 0.5;
+}
+
+double cumulative_continuous(std::span<const std::uint32_t> histogram, double value) {
+  double below = 0;
+  for (std::size_t v = 0; v < histogram.size(); ++v) {
+    const double lo = static_cast<double>(v) - 0.5;
+    if (value <= lo) break;
+    below += histogram[v] * std::min(1.0, value - lo);
+  }
+  return below;
+}
+
+double half_sample_mode(std::span<const std::uint32_t> histogram) {
+  std::size_t lo = 0, hi = histogram.size();
+  while (lo < hi && histogram[lo] == 0) ++lo;
+  while (hi > lo && histogram[hi - 1] == 0) --hi;
+  if (lo >= hi) return 0.0;
+  --hi;  // inclusive from here on
+  // Each pass keeps a strictly narrower run (a run of half the pixels always exists that is
+  // shorter than the whole), so this ends; the bound only guards against a mistake.
+  for (int pass = 0; pass < 64 && hi - lo + 1 > 3; ++pass) {
+    double mass = 0;
+    for (std::size_t v = lo; v <= hi; ++v) mass += histogram[v];
+    const double half = std::ceil(mass / 2);
+    // Narrowest [a, b] with at least `half` pixels (two pointers over the bins); of equally
+    // narrow runs the fullest, so that integer bins do not pull the mode to one side.
+    std::size_t best_a = lo, best_b = hi, b = lo;
+    double best_inside = 0, inside = histogram[lo];
+    for (std::size_t a = lo; a <= hi; ++a) {
+      while (inside < half && b < hi) inside += histogram[++b];
+      if (inside < half) break;
+      if (b - a < best_b - best_a || (b - a == best_b - best_a && inside > best_inside)) {
+        best_a = a;
+        best_b = b;
+        best_inside = inside;
+      }
+      inside -= histogram[a];
+    }
+    if (best_b - best_a >= hi - lo) break;
+    lo = best_a;
+    hi = best_b;
+  }
+  double sum = 0, weighted = 0;
+  for (std::size_t v = lo; v <= hi; ++v) {
+    sum += histogram[v];
+    weighted += static_cast<double>(v) * histogram[v];
+  }
+  return sum > 0 ? weighted / sum : static_cast<double>(lo);
+}
+
+double lower_half_sigma(std::span<const std::uint32_t> histogram, double mode) {
+  const double below_mode = cumulative_continuous(histogram, mode);
+  if (below_mode <= 0) return 0.0;
+  const double one_sigma_below = quantile_continuous(histogram, below_mode, kOneSigmaOfHalf);
+  return std::max(0.0, mode - one_sigma_below);
+}
+
+}  // namespace tomorig::quicklook::detail
