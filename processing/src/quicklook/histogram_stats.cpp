@@ -87,4 +87,37 @@ double lower_half_sigma(std::span<const std::uint32_t> histogram, double mode) {
   return std::max(0.0, mode - one_sigma_below);
 }
 
+double floor_clipped_sigma(std::span<const std::uint32_t> histogram, int floor) {
+  const double at_floor = histogram[static_cast<std::size_t>(floor)];
+  if (at_floor <= 0) return 0.0;
+  double below = 0;
+  for (int v = 0; v < floor; ++v) below += histogram[static_cast<std::size_t>(v)];
+  // Values measured from the floor; the floor bin ends half a count above it.
+  const double x = quantile_continuous(histogram, below + 1.5 * at_floor, 1.0) - floor;
+  const auto phi = [](double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); };
+  const auto g = [&](double sigma) { return phi(x / sigma) - 1.5 * phi(0.5 / sigma); };
+  // g < 0 at both ends (tiny sigma: the floor would hold nearly everything; huge sigma: it
+  // would hold half), > 0 between: the root on the falling side is the background's noise
+  // (the other makes the floor hold more than two thirds of it). Bracket it on a log grid.
+  if (!(x > 0.5)) return 0.0;
+  double lo = 0, hi = 0;
+  constexpr int kGrid = 400;
+  const double first = 0.05, last = 1e4 * x;
+  for (int k = kGrid; k > 0; --k) {
+    const double a = first * std::pow(last / first, static_cast<double>(k - 1) / kGrid);
+    const double b = first * std::pow(last / first, static_cast<double>(k) / kGrid);
+    if (g(a) > 0 && g(b) <= 0) {
+      lo = a;
+      hi = b;
+      break;
+    }
+  }
+  if (lo <= 0) return 0.0;
+  for (int it = 0; it < 60; ++it) {
+    const double mid = std::sqrt(lo * hi);
+    (g(mid) > 0 ? lo : hi) = mid;
+  }
+  return std::sqrt(lo * hi);
+}
+
 }  // namespace tomorig::quicklook::detail

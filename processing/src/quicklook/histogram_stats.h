@@ -26,4 +26,11 @@ double half_sample_mode(std::span<const std::uint32_t> histogram);
 // mode lie more than 1 sigma below it.
 double lower_half_sigma(std::span<const std::uint32_t> histogram, double mode);
 
+// Noise of a background clipped at `floor` (a camera without black level: every negative
+// excursion reads `floor`). Assumes the background is centred on the floor, which then holds
+// Mb Phi(1/2 / sigma) of its Mb pixels; the value x reached by another half of the floor's count
+// satisfies Phi(x / sigma) = 1.5 Phi(1/2 / sigma), solved for sigma. 0 if there is no solution
+// (sigma too small for the floor to hold less than two thirds of the background).
+double floor_clipped_sigma(std::span<const std::uint32_t> histogram, int floor);
+
 }  // namespace tomorig::quicklook::detail

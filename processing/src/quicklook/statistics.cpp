@@ -26,6 +26,8 @@ constexpr double kSobelNoise = 24.0;
 // Rounding to integer counts alone is noise of 1 / sqrt(12) counts.
 const double kQuantisationNoise = 1.0 / std::sqrt(12.0);
 constexpr int kMinSize = 8;
+// A frame whose lowest value holds more than this share of its pixels, at its mode, is clipped.
+constexpr double kClippedFloorFraction = 0.05;
 
 void check_target(const Target& t, std::string_view what) {
   if (const std::string problem = t.validate(what); !problem.empty()) throw bad_input(problem);
@@ -161,7 +163,14 @@ void QuickLook::analyse(const Image& image, FrameStatistics& out) {
     out.histogram[bin] += w.histogram[v];
   }
   out.background = detail::half_sample_mode(hist);
-  const double noise_below_mode = detail::lower_half_sigma(hist, out.background);
+  double noise = detail::lower_half_sigma(hist, out.background);
+  // A frame clipped at its lowest value (no black level) has no lower half to read the noise
+  // from: the floor holds every negative excursion.
+  const int floor = static_cast<int>(detail::quantile(hist, pixels, 0.0));
+  if (out.background - floor < 1.0 && w.histogram[static_cast<std::size_t>(floor)] > kClippedFloorFraction * pixels) {
+    out.background = floor;
+    noise = detail::floor_clipped_sigma(hist, floor);
+  }
 
   // ---- Tile sums: mean, saturation, autocovariance.
   double sum = 0, saturated = 0, weight = 0;
@@ -181,7 +190,7 @@ void QuickLook::analyse(const Image& image, FrameStatistics& out) {
   const double c2 = 0.5 * (cov[detail::lag_x2] + cov[detail::lag_y2]) / weight;
   const double sigma_px = c1 > 0 && c2 > 0 ? detail::sigma_from_lag_ratio(c1 / c2) : not_measured;
   out.diameter_px.set(4.0 * sigma_px, targets.diameter_px);
-  out.noise = std::max(noise_below_mode, kQuantisationNoise);
+  out.noise = std::max(noise, kQuantisationNoise);
 
   // ---- Local background and thresholds.
   const double frame_low = detail::quantile(hist, pixels, kLowFraction);
