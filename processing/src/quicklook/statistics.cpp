@@ -16,9 +16,6 @@
 namespace tomorig::quicklook {
 namespace {
 
-// The tile's low percentile (of a sparse sample) places its local background; the same
-// percentile of the whole frame ties it to the frame's background level.
-constexpr double kLowFraction = 0.05;
 // Sobel's response: 8 x the gradient (kernel [1 2 1] x [-1 0 1]); to white noise of variance
 // v: 12 v per axis.
 constexpr double kSobelGain2 = 64.0;
@@ -26,6 +23,8 @@ constexpr double kSobelNoise = 24.0;
 // Rounding to integer counts alone is noise of 1 / sqrt(12) counts.
 const double kQuantisationNoise = 1.0 / std::sqrt(12.0);
 constexpr int kMinSize = 8;
+// Lag covariances count as particle signal beyond this many standard deviations of chance.
+constexpr double kSignificance = 10.0;
 // A frame whose lowest value holds more than this share of its pixels, at its mode, is clipped.
 constexpr double kClippedFloorFraction = 0.05;
 
@@ -107,7 +106,7 @@ struct QuickLook::Work {
   detail::TileGrid grid;
   std::vector<std::uint32_t> histogram;  // full resolution: one bin per value
   std::vector<detail::TileSums> tiles;
-  std::vector<std::uint16_t> sample;
+  detail::TileScratch tile_scratch;
   std::vector<std::int32_t> thresholds;
   std::vector<std::uint32_t> maxima;
   std::vector<float> scratch;
@@ -121,7 +120,8 @@ struct QuickLook::Work {
     maxima.resize(n);
     scratch.reserve(n);
     const std::size_t per_row = static_cast<std::size_t>(tile / detail::kSampleStep + 1);
-    sample.resize(per_row * per_row);
+    tile_scratch.sample.resize(per_row * per_row);
+    tile_scratch.histogram.resize(detail::kTileBins);
     histogram.assign(image.type() == SampleType::u8 ? 256u : 65536u, 0u);
   }
 };
@@ -142,7 +142,7 @@ void QuickLook::analyse(const Image& image, FrameStatistics& out) {
   const QuickLookTargets& targets = options_.targets;
 
   // ---- Pass 1: histogram and tile sums.
-  detail::accumulate(image, g, full_scale, kLowFraction, w.histogram, w.tiles, w.sample);
+  detail::accumulate(image, g, full_scale, w.histogram, w.tiles, w.tile_scratch);
   const double pixels = static_cast<double>(image.width()) * image.height();
   out.width = image.width();
   out.height = image.height();
@@ -162,24 +162,29 @@ void QuickLook::analyse(const Image& image, FrameStatistics& out) {
                                            static_cast<std::size_t>(static_cast<double>(v) / out.histogram_bin_width));
     out.histogram[bin] += w.histogram[v];
   }
-  out.background = detail::half_sample_mode(hist);
-  double noise = detail::lower_half_sigma(hist, out.background);
+
+  // ---- Background and noise: each tile's (tile_pass.h), the frame's the median over tiles, so
+  // that a gradient of stray light neither blurs the level nor passes for noise.
+  w.scratch.clear();
+  for (const detail::TileSums& t : w.tiles) w.scratch.push_back(static_cast<float>(t.background));
+  out.background = median_of(w.scratch);
+  w.scratch.clear();
+  for (const detail::TileSums& t : w.tiles) w.scratch.push_back(static_cast<float>(t.noise));
+  double noise = median_of(w.scratch);
   // A frame clipped at its lowest value (no black level) has no lower half to read the noise
   // from: the floor holds every negative excursion.
-  const int floor = static_cast<int>(detail::quantile(hist, pixels, 0.0));
-  if (out.background - floor < 1.0 && w.histogram[static_cast<std::size_t>(floor)] > kClippedFloorFraction * pixels) {
-    out.background = floor;
-    noise = detail::floor_clipped_sigma(hist, floor);
-  }
+  const double floor = detail::quantile(hist, pixels, 0.0);
+  const bool clipped = out.background - floor < 1.0 &&
+                       w.histogram[static_cast<std::size_t>(floor)] > kClippedFloorFraction * pixels;
+  if (clipped) noise = detail::floor_clipped_sigma(hist, static_cast<int>(floor));
 
   // ---- Tile sums: mean, saturation, autocovariance.
   double sum = 0, saturated = 0, weight = 0;
-  double cov0 = 0, cov[detail::lag_count] = {};
+  double cov[detail::lag_count] = {};
   for (const detail::TileSums& t : w.tiles) {
     sum += t.offset * t.n + t.sum;
     saturated += t.saturated;
     weight += t.n;
-    cov0 += t.n * t.variance();
     for (int lag = 0; lag < detail::lag_count; ++lag) cov[lag] += t.n * t.covariance(lag);
   }
   out.mean = sum / pixels;
@@ -188,25 +193,30 @@ void QuickLook::analyse(const Image& image, FrameStatistics& out) {
   // d_tau from the ratio of lags 1 and 2, which white noise does not reach.
   const double c1 = 0.5 * (cov[detail::lag_x1] + cov[detail::lag_y1]) / weight;
   const double c2 = 0.5 * (cov[detail::lag_x2] + cov[detail::lag_y2]) / weight;
-  const double sigma_px = c1 > 0 && c2 > 0 ? detail::sigma_from_lag_ratio(c1 / c2) : not_measured;
-  out.diameter_px.set(4.0 * sigma_px, targets.diameter_px);
   out.noise = std::max(noise, kQuantisationNoise);
+  // White noise alone leaves lag covariances of about noise^2 / sqrt(pixels) (either sign):
+  // both lags must stand well clear of that to say anything about particle images.
+  const double chance = kSignificance * out.noise * out.noise / std::sqrt(pixels);
+  const double sigma_px = c1 > chance && c2 > chance ? detail::sigma_from_lag_ratio(c1 / c2) : not_measured;
+  out.diameter_px.set(4.0 * sigma_px, targets.diameter_px);
 
   // ---- Local background and thresholds.
-  const double frame_low = detail::quantile(hist, pixels, kLowFraction);
   resize_map(out.background_map, g);
   resize_map(out.saturation_map, g);
   resize_map(out.focus_map, g);
   const double rise = options_.peak_sigmas * out.noise;
   w.scratch.clear();
+  double background_sum = 0;
   for (std::size_t n = 0; n < w.tiles.size(); ++n) {
     const detail::TileSums& t = w.tiles[n];
-    const double local = out.background + (t.low_sample - frame_low);
+    const double local = clipped ? std::max(floor, t.background) : t.background;
+    background_sum += local * t.n;
     out.background_map.values[n] = static_cast<float>(local);
     out.saturation_map.values[n] = static_cast<float>(t.saturated / t.n);
     w.thresholds[n] = static_cast<std::int32_t>(std::clamp(std::floor(local + rise), -1.0, 65536.0));
     w.scratch.push_back(static_cast<float>(local));
   }
+  out.mean_excess = out.mean - background_sum / pixels;
   out.background_p5 = percentile_of(w.scratch, 0.05);
   out.background_p50 = percentile_of(w.scratch, 0.50);
   out.background_p95 = percentile_of(w.scratch, 0.95);
@@ -218,7 +228,7 @@ void QuickLook::analyse(const Image& image, FrameStatistics& out) {
 
   // ---- ppp: two lower bounds (particle_model.h), the larger kept. Overlapping images make
   // the maxima undercount; unequal brightness makes the autocovariance estimate low.
-  out.ppp_autocovariance = detail::density_from_autocovariance(out.mean_excess(), c1, sigma_px);
+  out.ppp_autocovariance = detail::density_from_autocovariance(out.mean_excess, c1, sigma_px);
   const double ppp = std::isfinite(out.ppp_autocovariance) ? std::max(out.ppp_autocovariance, out.maxima_per_pixel)
                                                            : out.maxima_per_pixel;
   out.ppp.set(ppp, targets.ppp);
@@ -259,7 +269,7 @@ void QuickLook::analyse(const Image& a, const Image& b, CameraQuickLook& out) {
                                 a.height(), to_string(a.type()), b.width(), b.height(), to_string(b.type())));
   analyse(a, out.a);
   analyse(b, out.b);
-  const double excess_a = out.a.mean_excess(), excess_b = out.b.mean_excess();
+  const double excess_a = out.a.mean_excess, excess_b = out.b.mean_excess;
   out.energy_balance.set(excess_a > 0 && excess_b >= 0 ? excess_b / excess_a : not_measured,
                          options_.targets.energy_balance);
 }

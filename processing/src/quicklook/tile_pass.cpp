@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "histogram_stats.h"
+
 namespace tomorig::quicklook::detail {
 namespace {
 
@@ -26,9 +28,44 @@ void row_products(const T* a, const T* b, int x0, int x1, int shift, float offse
   sum_b = s;
 }
 
+// The tile's background level and noise from its own histogram (every other row): a window of
+// kTileBins bins placed by the sampled 5th percentile, the bins wide enough that the sampled
+// 5th to 50th percentiles span about 32 of them; half-sample mode and lower-half noise as for
+// the whole frame (histogram_stats.h).
 template <typename T>
-void accumulate_tile(const Image& image, const TileGrid& g, int i, int j, int full_scale, double low_fraction,
-                     std::uint32_t* histogram, TileSums& t, std::vector<std::uint16_t>& sample) {
+void tile_background(const Image& image, int x0, int x1, int y0, int y1, std::size_t samples, TileSums& t,
+                     TileScratch& scratch) {
+  std::vector<std::uint16_t>& sample = scratch.sample;
+  const auto end = sample.begin() + static_cast<std::ptrdiff_t>(samples);
+  const auto k5 = static_cast<std::ptrdiff_t>(0.05 * static_cast<double>(samples - 1));
+  const auto k50 = static_cast<std::ptrdiff_t>(0.50 * static_cast<double>(samples - 1));
+  std::nth_element(sample.begin(), sample.begin() + k5, end);
+  const int p5 = sample[static_cast<std::size_t>(k5)];
+  std::nth_element(sample.begin() + k5, sample.begin() + k50, end);
+  const int p50 = sample[static_cast<std::size_t>(k50)];
+  const int width = std::max(1, (p50 - p5 + 31) / 32);
+  const int origin = p5 - kTileBinsBelow * width;
+
+  std::uint32_t* h = scratch.histogram.data();
+  std::fill(h, h + kTileBins, 0u);
+  for (int y = y0; y < y1; y += 2) {
+    const T* r = image.row<T>(y);
+    for (int x = x0; x < x1; ++x) {
+      const int d = static_cast<int>(r[x]) - origin;
+      ++h[d < 0 ? 0 : std::min(kTileBins - 1, d / width)];
+    }
+  }
+  const std::span<const std::uint32_t> bins(h, kTileBins);
+  const double mode = half_sample_mode(bins);
+  // Bin b holds values origin + b * width .. origin + (b + 1) * width - 1.
+  t.background = origin + mode * width + 0.5 * (width - 1);
+  t.noise = lower_half_sigma(bins, mode) * width;
+}
+
+template <typename T>
+void accumulate_tile(const Image& image, const TileGrid& g, int i, int j, int full_scale, std::uint32_t* histogram,
+                     TileSums& t, TileScratch& scratch) {
+  std::vector<std::uint16_t>& sample = scratch.sample;
   const int x0 = g.x0(i), x1 = g.x1(i), y0 = g.y0(j), y1 = g.y1(j);
   const int w = x1 - x0;
   t = TileSums{};
@@ -105,21 +142,17 @@ void accumulate_tile(const Image& image, const TileGrid& g, int i, int j, int fu
       for (int x = x0 + kSampleStep / 2; x < x1; x += kSampleStep) sample[samples++] = r0[x];
   }
   if (samples == 0) sample[samples++] = image.row<T>(y0)[x0];  // a sliver of a tile
-  const auto k = static_cast<std::size_t>(low_fraction * static_cast<double>(samples - 1));
-  std::nth_element(sample.begin(), sample.begin() + static_cast<std::ptrdiff_t>(k),
-                   sample.begin() + static_cast<std::ptrdiff_t>(samples));
-  t.low_sample = sample[k];
+  tile_background<T>(image, x0, x1, y0, y1, samples, t, scratch);
 }
 
 template <typename T>
-void accumulate_all(const Image& image, const TileGrid& g, int full_scale, double low_fraction,
-                    std::vector<std::uint32_t>& histogram, std::vector<TileSums>& tiles,
-                    std::vector<std::uint16_t>& sample) {
+void accumulate_all(const Image& image, const TileGrid& g, int full_scale, std::vector<std::uint32_t>& histogram,
+                    std::vector<TileSums>& tiles, TileScratch& scratch) {
   // Tile rows outer, so a band of tile + 2 image rows stays in cache while its tiles are done.
   for (int j = 0; j < g.ny; ++j)
     for (int i = 0; i < g.nx; ++i)
-      accumulate_tile<T>(image, g, i, j, full_scale, low_fraction, histogram.data(),
-                         tiles[static_cast<std::size_t>(i + g.nx * j)], sample);
+      accumulate_tile<T>(image, g, i, j, full_scale, histogram.data(), tiles[static_cast<std::size_t>(i + g.nx * j)],
+                         scratch);
 }
 
 template <typename T>
@@ -173,13 +206,12 @@ double TileSums::covariance(int lag) const {
   return (sum_xy[lag] - m * (sum_x[lag] + sum_y[lag])) / p + m * m;
 }
 
-void accumulate(const Image& image, const TileGrid& grid, int full_scale, double low_fraction,
-                std::vector<std::uint32_t>& histogram, std::vector<TileSums>& tiles,
-                std::vector<std::uint16_t>& sample) {
+void accumulate(const Image& image, const TileGrid& grid, int full_scale, std::vector<std::uint32_t>& histogram,
+                std::vector<TileSums>& tiles, TileScratch& scratch) {
   if (image.type() == SampleType::u8)
-    accumulate_all<std::uint8_t>(image, grid, full_scale, low_fraction, histogram, tiles, sample);
+    accumulate_all<std::uint8_t>(image, grid, full_scale, histogram, tiles, scratch);
   else
-    accumulate_all<std::uint16_t>(image, grid, full_scale, low_fraction, histogram, tiles, sample);
+    accumulate_all<std::uint16_t>(image, grid, full_scale, histogram, tiles, scratch);
 }
 
 std::uint64_t count_maxima(const Image& image, const TileGrid& grid, const std::vector<std::int32_t>& thresholds,

@@ -1,7 +1,7 @@
 #pragma once
 // The two passes of the quick-look statistics over a frame, tile by tile (statistics.h):
 //   accumulate():   histogram, moments, saturation, Sobel energy, autocovariance sums at lags
-//                   1 and 2 along x and y, and a sparse sample for the local background;
+//                   1 and 2 along x and y, and each tile's background level and noise;
 //   count_maxima(): local maxima above each tile's threshold.
 // Both walk the image once, tile by tile, in loops the compiler vectorises (`omp simd`
 // reductions); neither allocates.
@@ -38,7 +38,8 @@ struct TileSums {
   double sobel = 0, sobel_n = 0;  // sum of Gx^2 + Gy^2 over pixels with a full 3 x 3 neighbourhood
   // Pairs (d(p), d(p + lag)) inside the tile: count, sum of products, sums of either member.
   double pairs[lag_count] = {}, sum_xy[lag_count] = {}, sum_x[lag_count] = {}, sum_y[lag_count] = {};
-  float low_sample = 0;  // the sampled low percentile of the tile, counts
+  // The tile's background: half-sample mode of its histogram and the noise below it (counts).
+  double background = 0, noise = 0;
 
   double mean() const { return n > 0 ? offset + sum / n : 0.0; }
   double variance() const;
@@ -46,17 +47,23 @@ struct TileSums {
   double covariance(int lag) const;
 };
 
-// Every `kSampleStep`-th pixel of every `kSampleStep`-th row of a tile is sampled for its
-// local background percentile: 256 samples for a 64 px tile.
+// Every `kSampleStep`-th pixel of every `kSampleStep`-th row of a tile is sampled to place the
+// window of the tile's own histogram: 256 samples for a 64 px tile.
 constexpr int kSampleStep = 4;
+// The tile histogram: bins, and how many of them lie below the sample's 5th percentile.
+constexpr int kTileBins = 256;
+constexpr int kTileBinsBelow = 64;
 
-// Pass 1. `histogram` must hold 2^bits entries of the sample type (256 or 65536) and is
-// added to; `tiles` must hold grid.count() entries and is overwritten; `sample` is scratch of
-// at least (tile / kSampleStep + 1)^2 entries. `low_fraction` picks the percentile of the
-// tile sample stored in TileSums::low_sample.
-void accumulate(const Image& image, const TileGrid& grid, int full_scale, double low_fraction,
-                std::vector<std::uint32_t>& histogram, std::vector<TileSums>& tiles,
-                std::vector<std::uint16_t>& sample);
+// Scratch of one tile's background estimate.
+struct TileScratch {
+  std::vector<std::uint16_t> sample;     // (tile / kSampleStep + 1)^2 entries
+  std::vector<std::uint32_t> histogram;  // kTileBins entries
+};
+
+// Pass 1. `histogram` must hold 2^bits entries of the sample type (256 or 65536) and is added
+// to; `tiles` must hold grid.count() entries and is overwritten.
+void accumulate(const Image& image, const TileGrid& grid, int full_scale, std::vector<std::uint32_t>& histogram,
+                std::vector<TileSums>& tiles, TileScratch& scratch);
 
 // Pass 2. Counts pixels (with a full 3 x 3 neighbourhood) that exceed their tile's threshold
 // (integer counts: a pixel counts if value > threshold) and are the maximum of their 3 x 3

@@ -80,6 +80,7 @@ struct FrameStatistics {
   std::vector<std::uint32_t> histogram;  // options.histogram_bins bins over [0, full_scale]
   double histogram_bin_width = 0;        // counts per bin
   double mean = 0;                       // counts, all pixels
+  double mean_excess = 0;                // mean above the local background: the particles' light
   Percentiles percentiles;
 
   // Background: the most probable level of pixels that hold no particle image (half-sample
@@ -104,13 +105,13 @@ struct FrameStatistics {
                                   // from the autocovariance width, pixel integration removed
   Judged source_density;          // Ns = ppp (pi / 4) d_tau^2
 
-  // Focus per tile: Sobel gradient energy minus its noise part, over 64 x the tile's variance
-  // minus the noise variance. About 1 / s^2 (px^-2) for particle images of Gaussian width s:
-  // it drops where images blur. NaN for tiles without particle signal.
+  // Focus per tile (normalised Tenengrad): the Sobel gradient energy minus its noise part, over
+  // 64 x the tile's variance minus the noise variance (px^-2). It depends on the particle image
+  // shape only, not on brightness or density, and falls as the images blur. NaN for tiles
+  // without particle signal.
   TileMap focus_map;
   Judged soft_tile_fraction;  // tiles (with signal) whose focus is below half the median
 
-  double mean_excess() const { return mean - background; }
   Flag overall() const;  // the worst flag of this frame
 };
 
