@@ -3,6 +3,7 @@
 // used here without the correction.
 #include "tomorig/processing/quicklook/drift_monitor.h"
 
+#include <algorithm>
 #include <deque>
 
 #include <fmt/format.h>
@@ -42,6 +43,8 @@ void DriftOptions::validate() const {
     throw bad_input(fmt::format("drift.search_radius_px = {} is out of range: (0, 20] px", search_radius_px));
   if (window_sets < 1 || window_sets > 1000)
     throw bad_input(fmt::format("drift.window_sets = {} is out of range: 1 to 1000", window_sets));
+  if (warmup_sets < 1)
+    throw bad_input(fmt::format("drift.warmup_sets = {} must be >= 1", warmup_sets));
   if (min_matches_per_subvolume < 1)
     throw bad_input(fmt::format("drift.min_matches_per_subvolume = {} must be >= 1", min_matches_per_subvolume));
   if (!(warn_px > 0 && warn_px < search_radius_px))
@@ -153,7 +156,7 @@ void DriftMonitor::measure() {
       if (!out.valid) continue;
       ++r.valid_subvolumes[c];
       r.largest_px[c] = std::max(r.largest_px[c], out.magnitude());
-      if (out.magnitude() > options_.warn_px) {
+      if (out.magnitude() > options_.warn_px && r.sets >= std::min(options_.warmup_sets, options_.window_sets)) {
         DriftAlarm alarm;
         alarm.camera = name_of(options_, c);
         alarm.camera_index = static_cast<int>(c);

@@ -37,6 +37,7 @@ struct DriftOptions {
   // (reported as too few matched particles) rather than growing the disparity.
   double search_radius_px = 1.0;
   int window_sets = 10;                 // sets whose matches are pooled
+  int warmup_sets = 3;                  // no alarm before the window holds this many (or all) sets
   int min_matches_per_subvolume = 10;   // matches near the disparity peak for a sub-volume to count
   double warn_px = 0.3;                 // a sub-volume disparity above this is an alarm
   double peak_threshold = 0;            // particle peaks below this are ignored (counts; 0: automatic)
@@ -68,7 +69,7 @@ struct DriftReport {
   std::vector<std::vector<SubvolumeDrift>> cameras;  // [camera][sub-volume], x fastest
   std::vector<double> largest_px;  // per camera: the largest valid sub-volume disparity
   std::vector<int> valid_subvolumes;  // per camera
-  std::vector<DriftAlarm> alarms;
+  std::vector<DriftAlarm> alarms;  // none while warming up (fewer than warmup_sets sets)
   // red: an alarm; amber: a camera with fewer than 4 valid sub-volumes (cannot be watched:
   // too few particles, or a drift beyond the search radius); green otherwise.
   Flag flag = Flag::amber;
