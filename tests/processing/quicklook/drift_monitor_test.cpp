@@ -120,7 +120,9 @@ TEST(DriftMonitor, CameraMovedHalfAPixelMidRunIsNamedWithinTwentySets) {
       fired_at = k;
       std::printf("%s\n", r.alarms.front().message.c_str());
     }
-    if (fired_at >= 0) EXPECT_EQ(r.flag, Flag::red);
+    if (fired_at >= 0) {
+      EXPECT_EQ(r.flag, Flag::red);
+    }
     // The unmoved cameras keep well below the warning.
     for (const std::size_t c : {0, 2, 3}) EXPECT_LT(r.largest_px[c], 0.15) << "set " << k << " camera " << c;
     if (k == last) {
