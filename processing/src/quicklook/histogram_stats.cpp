@@ -87,6 +87,45 @@ double lower_half_sigma(std::span<const std::uint32_t> histogram, double mode) {
   return std::max(0.0, mode - one_sigma_below);
 }
 
+double refine_mode(std::span<const std::uint32_t> histogram, double mode, double sigma) {
+  if (!(sigma >= 1.5)) return mode;  // too few bins across the peak to fit
+  const auto lo = static_cast<std::ptrdiff_t>(std::max(0.0, std::ceil(mode - 2.0 * sigma)));
+  const auto hi = std::min(static_cast<std::ptrdiff_t>(histogram.size()) - 1,
+                           static_cast<std::ptrdiff_t>(std::floor(mode + 0.5 * sigma)));
+  // Weighted least squares of log h = c0 + c1 u + c2 u^2, u = v - mode.
+  double m[3][4] = {};
+  int used = 0;
+  for (std::ptrdiff_t v = lo; v <= hi; ++v) {
+    const double h = histogram[static_cast<std::size_t>(v)];
+    if (h < 1) continue;
+    const double u = static_cast<double>(v) - mode, y = std::log(h);
+    const double basis[3] = {1.0, u, u * u};
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) m[r][c] += h * basis[r] * basis[c];
+      m[r][3] += h * basis[r] * y;
+    }
+    ++used;
+  }
+  if (used < 4) return mode;
+  // Gaussian elimination with partial pivoting on the 3 x 4 system.
+  for (int col = 0; col < 3; ++col) {
+    int pivot = col;
+    for (int r = col + 1; r < 3; ++r)
+      if (std::abs(m[r][col]) > std::abs(m[pivot][col])) pivot = r;
+    if (std::abs(m[pivot][col]) < 1e-12) return mode;
+    for (int c = 0; c < 4; ++c) std::swap(m[col][c], m[pivot][c]);
+    for (int r = 0; r < 3; ++r) {
+      if (r == col) continue;
+      const double f = m[r][col] / m[col][col];
+      for (int c = col; c < 4; ++c) m[r][c] -= f * m[col][c];
+    }
+  }
+  const double c1 = m[1][3] / m[1][1], c2 = m[2][3] / m[2][2];
+  if (!(c2 < 0)) return mode;
+  const double shift = -c1 / (2 * c2);
+  return std::abs(shift) <= sigma ? mode + shift : mode;
+}
+
 double floor_clipped_sigma(std::span<const std::uint32_t> histogram, int floor) {
   const double at_floor = histogram[static_cast<std::size_t>(floor)];
   if (at_floor <= 0) return 0.0;

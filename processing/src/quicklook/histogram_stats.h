@@ -26,6 +26,13 @@ double half_sample_mode(std::span<const std::uint32_t> histogram);
 // mode lie more than 1 sigma below it.
 double lower_half_sigma(std::span<const std::uint32_t> histogram, double mode);
 
+// The background level refined from a rough `mode` and `sigma` (bins): a Gaussian fitted to the
+// histogram's lower flank, bins in [mode - 2 sigma, mode + sigma / 2] (log counts, weighted by
+// the counts), whose centre is the level. Uses a few hundred bins' worth of pixels where the
+// half-sample mode rests on a handful, and leaves out the upper flank, which particle light
+// lifts. Returns `mode` if the fit is not a downward parabola or moves more than sigma.
+double refine_mode(std::span<const std::uint32_t> histogram, double mode, double sigma);
+
 // Noise of a background clipped at `floor` (a camera without black level: every negative
 // excursion reads `floor`). Assumes the background is centred on the floor, which then holds
 // Mb Phi(1/2 / sigma) of its Mb pixels; the value x reached by another half of the floor's count

@@ -122,7 +122,8 @@ struct QuickLook::Work {
     const std::size_t per_row = static_cast<std::size_t>(tile / detail::kSampleStep + 1);
     tile_scratch.sample.resize(per_row * per_row);
     tile_scratch.histogram.resize(detail::kTileBins);
-    histogram.assign(image.type() == SampleType::u8 ? 256u : 65536u, 0u);
+    tile_scratch.tile.resize(static_cast<std::size_t>(tile + 2) * static_cast<std::size_t>(tile + 2));
+    histogram.assign(2 * detail::kHistogramStride, 0u);
   }
 };
 
@@ -149,18 +150,19 @@ void QuickLook::analyse(const Image& image, FrameStatistics& out) {
   out.full_scale = full_scale;
 
   // ---- Histogram figures.
-  const std::span<const std::uint32_t> hist(w.histogram);
+  const std::span<const std::uint32_t> hist =
+      detail::histogram_halves(w.histogram, image.type() == SampleType::u8 ? 256u : 65536u);
   out.percentiles = {detail::quantile(hist, pixels, 0.01),  detail::quantile(hist, pixels, 0.05),
                      detail::quantile(hist, pixels, 0.50),  detail::quantile(hist, pixels, 0.95),
                      detail::quantile(hist, pixels, 0.99),  detail::quantile(hist, pixels, 0.999)};
   const int bins = options_.histogram_bins;
   out.histogram.assign(static_cast<std::size_t>(bins), 0u);
   out.histogram_bin_width = (full_scale + 1.0) / bins;
-  for (std::size_t v = 0; v < w.histogram.size(); ++v) {
-    if (w.histogram[v] == 0) continue;
+  for (std::size_t v = 0; v < hist.size(); ++v) {
+    if (hist[v] == 0) continue;
     const auto bin = std::min<std::size_t>(static_cast<std::size_t>(bins - 1),
                                            static_cast<std::size_t>(static_cast<double>(v) / out.histogram_bin_width));
-    out.histogram[bin] += w.histogram[v];
+    out.histogram[bin] += hist[v];
   }
 
   // ---- Background and noise: each tile's (tile_pass.h), the frame's the median over tiles, so
@@ -175,7 +177,7 @@ void QuickLook::analyse(const Image& image, FrameStatistics& out) {
   // from: the floor holds every negative excursion.
   const double floor = detail::quantile(hist, pixels, 0.0);
   const bool clipped = out.background - floor < 1.0 &&
-                       w.histogram[static_cast<std::size_t>(floor)] > kClippedFloorFraction * pixels;
+                       hist[static_cast<std::size_t>(floor)] > kClippedFloorFraction * pixels;
   if (clipped) noise = detail::floor_clipped_sigma(hist, static_cast<int>(floor));
 
   // ---- Tile sums: mean, saturation, autocovariance.

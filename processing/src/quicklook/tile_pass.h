@@ -6,6 +6,7 @@
 // Both walk the image once, tile by tile, in loops the compiler vectorises (`omp simd`
 // reductions); neither allocates.
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "tomorig/core/image.h"
@@ -48,22 +49,31 @@ struct TileSums {
 };
 
 // Every `kSampleStep`-th pixel of every `kSampleStep`-th row of a tile is sampled to place the
-// window of the tile's own histogram: 256 samples for a 64 px tile.
-constexpr int kSampleStep = 4;
+// window of the tile's own histogram: 64 samples for a 64 px tile.
+constexpr int kSampleStep = 8;
 // The tile histogram: bins, and how many of them lie below the sample's 5th percentile.
 constexpr int kTileBins = 256;
 constexpr int kTileBinsBelow = 64;
 
 // Scratch of one tile's background estimate.
 struct TileScratch {
+  std::vector<float> tile;               // (tile + 2)^2 entries: a tile and its border as floats
   std::vector<std::uint16_t> sample;     // (tile / kSampleStep + 1)^2 entries
   std::vector<std::uint32_t> histogram;  // kTileBins entries
 };
 
-// Pass 1. `histogram` must hold 2^bits entries of the sample type (256 or 65536) and is added
-// to; `tiles` must hold grid.count() entries and is overwritten.
+// The frame histogram is kept as two halves (even and odd columns) of this many entries each,
+// enough for 16-bit samples; histogram_halves() adds them up.
+constexpr std::size_t kHistogramStride = 65536;
+
+// Pass 1. `histogram` must hold 2 * kHistogramStride entries, zero on entry (the sums of even
+// and odd columns); `tiles` must hold grid.count() entries and is overwritten.
 void accumulate(const Image& image, const TileGrid& grid, int full_scale, std::vector<std::uint32_t>& histogram,
                 std::vector<TileSums>& tiles, TileScratch& scratch);
+
+// Adds the odd-column half of `histogram` into the even one and returns the latter's first
+// `values` entries (256 for 8-bit samples, 65536 for 16-bit).
+std::span<const std::uint32_t> histogram_halves(std::vector<std::uint32_t>& histogram, std::size_t values);
 
 // Pass 2. Counts pixels (with a full 3 x 3 neighbourhood) that exceed their tile's threshold
 // (integer counts: a pixel counts if value > threshold) and are the maximum of their 3 x 3

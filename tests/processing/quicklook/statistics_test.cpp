@@ -122,10 +122,10 @@ TEST(QuickLook, BlurredHalfOfTheFrameShowsInTheFocusMap) {
 
 TEST(QuickLook, LocalBackgroundFollowsAGradient) {
   FieldSpec spec;
-  spec.ppp = 0.05;
+  spec.ppp = 0.02;  // sparse: the particles' own lift of the background stays small (accuracy test)
   const auto field = make_field(spec);
   // Add a ramp of 0 .. 30 counts (6 noise sigma) across the frame to the signal, as stray light.
-  // Each tile's level within 1 sigma (5 counts) of the ramp at its centre.
+  // Each tile's level within 1.5 sigma (7.5 counts) of the ramp at its centre, and no bias.
   Image signal = field.signal.clone();
   for (int y = 0; y < spec.height; ++y)
     for (int x = 0; x < spec.width; ++x) signal.at<float>(x, y) += 30.0f * static_cast<float>(x) / spec.width;
@@ -133,10 +133,15 @@ TEST(QuickLook, LocalBackgroundFollowsAGradient) {
   QuickLook ql;
   FrameStatistics s;
   ql.analyse(image, s);
+  double error_sum = 0;
   for (int i = 0; i < s.background_map.tiles_x; ++i) {
     const double truth = spec.offset_counts + 30.0 * (i * 64 + 32) / spec.width;
-    for (int j = 0; j < s.background_map.tiles_y; ++j) EXPECT_NEAR(s.background_map.at(i, j), truth, 5.0) << i << "," << j;
+    for (int j = 0; j < s.background_map.tiles_y; ++j) {
+      EXPECT_NEAR(s.background_map.at(i, j), truth, 7.5) << i << "," << j;
+      error_sum += s.background_map.at(i, j) - truth;
+    }
   }
+  EXPECT_NEAR(error_sum / 64, 0.0, 1.0);  // no bias across the ramp
   EXPECT_NEAR(s.ppp.value, field.true_ppp(), 0.10 * field.true_ppp());
   EXPECT_NEAR(s.diameter_px.value, 3.0, 0.3);
 }
