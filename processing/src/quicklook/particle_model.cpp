@@ -67,10 +67,6 @@ double sigma_from_lag_ratio(double ratio) {
   return std::exp(std::log(table_sigma(n - 1)) + f * (std::log(table_sigma(n)) - std::log(table_sigma(n - 1))));
 }
 
-double lag0_over_lag1(double sigma_px) {
-  return pixel_autocorrelation(0.0, sigma_px) / pixel_autocorrelation(1.0, sigma_px);
-}
-
 double density_from_autocovariance(double excess, double lag1_covariance, double sigma_px) {
   if (!(excess > 0 && lag1_covariance > 0 && std::isfinite(sigma_px))) return kNaN;
   return excess * excess * pixel_autocorrelation(0.0, sigma_px) * pixel_autocorrelation(1.0, sigma_px) /

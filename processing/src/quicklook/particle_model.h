@@ -7,8 +7,7 @@
 // density (Campbell's theorem), whatever the density; along x it is
 //   h(lag) = integral over t in [-1, 1] of (1 - |t|) phi_s(lag - t) dt,  s = sqrt(2) sigma,
 // the autocorrelation of the Gaussian (phi_s) convolved with that of the pixel box (the
-// triangle). White noise adds to lag 0 only, so sigma comes from the ratio of lags 1 and 2,
-// and the noise from what lag 0 holds beyond the model.
+// triangle). White noise adds to lag 0 only, so sigma comes from the ratio of lags 1 and 2.
 //
 // Particle image density from the same sums: the mean excess intensity is rho E[a] and the
 // lag-(1, 0) autocovariance rho E[a^2] h(1) h(0) (a: a particle image's integrated counts), so
@@ -24,9 +23,6 @@ double pixel_autocorrelation(double lag, double sigma_px);
 // sigma (px) whose h(1) / h(2) equals `ratio`; NaN outside the model's range (sigma in
 // [0.2, 8] px).
 double sigma_from_lag_ratio(double ratio);
-
-// h(0) / h(1) for `sigma_px`: extrapolates the particle part of the lag-0 autocovariance.
-double lag0_over_lag1(double sigma_px);
 
 // rho E[a]^2 / E[a^2] from the mean excess intensity and the mean of the lag-1
 // autocovariances along x and y; NaN unless all are positive and sigma is finite.
