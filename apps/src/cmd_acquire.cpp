@@ -19,18 +19,36 @@
 #include <zmq.hpp>
 
 #include "commands.h"
-#include "record_layout.h"
-#include "rig_acquisition.h"
-#include "rig_run_options.h"
-#include "rig_session_info.h"
-#include "send_with_retry.h"
-#include "rig_status.h"
-#include "stop_signal.h"
+#include "tomorig/rig/record_layout.h"
+#include "tomorig/rig/rig_acquisition.h"
+#include "tomorig/rig/rig_run_options.h"
+#include "tomorig/rig/rig_session_info.h"
+#include "tomorig/rig/send_with_retry.h"
+#include "tomorig/rig/rig_status.h"
+#include "tomorig/rig/stop_signal.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
 #include "tomorig/stream/frame_sender.h"
 
 namespace tomorig::app {
+
+using rig::rig_session_info;
+using rig::LossTally;
+using rig::RigAcquisition;
+using rig::RigAcquisitionOptions;
+using rig::RigProgress;
+using rig::RigRunChoices;
+using rig::SendOutcome;
+using rig::StatusFigures;
+using rig::StatusReporter;
+using rig::StopSignalGuard;
+using rig::add_rig_run_options;
+using rig::load_rig;
+using rig::rig_acquisition_options;
+using rig::run_length_text;
+using rig::send_with_retry;
+using rig::pixel_bytes;
+
 namespace {
 
 using Clock = std::chrono::steady_clock;

@@ -18,15 +18,21 @@
 #include <zmq.hpp>
 
 #include "commands.h"
-#include "record_layout.h"
-#include "stop_signal.h"
-#include "stream_session.h"
+#include "tomorig/rig/record_layout.h"
+#include "tomorig/rig/stop_signal.h"
+#include "tomorig/rig/stream_session.h"
 #include "tomorig/core/error.h"
 #include "tomorig/storage/session_file.h"
 #include "tomorig/stream/frame_receiver.h"
 #include "tomorig/stream/receive_memory.h"
 
 namespace tomorig::app {
+
+using rig::StreamSession;
+using rig::StopSignalGuard;
+using rig::set_matches_cameras;
+using rig::pixel_bytes;
+
 namespace {
 
 using Clock = std::chrono::steady_clock;

@@ -17,14 +17,25 @@
 #include <zmq.hpp>
 
 #include "commands.h"
-#include "replay_schedule.h"
-#include "send_with_retry.h"
-#include "stop_signal.h"
+#include "tomorig/rig/replay_schedule.h"
+#include "tomorig/rig/send_with_retry.h"
+#include "tomorig/rig/stop_signal.h"
 #include "tomorig/core/error.h"
 #include "tomorig/storage/session_file.h"
 #include "tomorig/stream/frame_sender.h"
 
 namespace tomorig::app {
+
+using rig::ReplayRate;
+using rig::ReplaySchedule;
+using rig::SendOutcome;
+using rig::SetRange;
+using rig::StopSignalGuard;
+using rig::make_replay_schedule;
+using rig::parse_replay_rate;
+using rig::parse_set_range;
+using rig::send_with_retry;
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
