@@ -188,7 +188,9 @@ void add_acquire_command(CLI::App& root) {
   cmd->add_flag("--allow-remote", opt->allow_remote, "Allow binding --to on a non-loopback address");
   cmd->add_option("--timeout", opt->timeout_s, "Seconds a send may wait for the recorder before giving up")
       ->capture_default_str();
-  cmd->add_option("--wait", opt->wait_s, "Seconds to wait for a recorder before the first set")->capture_default_str();
+  cmd->add_option("--wait", opt->wait_s, "Seconds to wait for a recorder to take the session start (the trigger "
+                                        "starts after it)")
+      ->capture_default_str();
   cmd->callback([opt] { acquire(*opt); });
 }
 

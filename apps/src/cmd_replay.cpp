@@ -189,7 +189,7 @@ void add_replay_command(CLI::App& root) {
   cmd->add_option("--timeout", opt->timeout_s, "Seconds a send may wait for the receiver before giving up")
       ->capture_default_str();
   cmd->add_option("--wait", opt->wait_s,
-                  "Seconds to wait for a receiver before the first set (at least one --timeout)")->capture_default_str();
+                  "Seconds to wait for a receiver to take the session start, the first message")->capture_default_str();
   cmd->callback([opt] { replay(*opt); });
 }
 

@@ -16,7 +16,7 @@ constexpr std::size_t kHeldTruth = 64;
 StreamSession::StartOutcome StreamSession::on_start(stream::SessionStart start, bool recording) {
   if (announced_ && announced_->session_id == start.session_id) return StartOutcome::repeated;
   if (recording) return StartOutcome::conflict;
-  // Nothing written yet: a sender that restarted before its first set simply replaces the
+  // No file yet: a sender that restarted before the file was opened simply replaces the
   // announcement.
   announced_ = std::move(start);
   ended_.reset();

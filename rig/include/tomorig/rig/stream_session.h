@@ -23,7 +23,7 @@ class StreamSession {
     repeated,   // the same start again: nothing changes
     conflict,   // another session started while one is being recorded: the recording must end
   };
-  // `recording`: sets of the current session have been written already.
+  // `recording`: the session file is open already (from this start's cameras or a first set).
   StartOutcome on_start(stream::SessionStart start, bool recording);
   // Keeps the truth for the set with its trigger index (ignored unless it belongs to the
   // announced session). Holds at most a few dozen: truth whose set never came is dropped.
