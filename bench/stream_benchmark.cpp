@@ -15,9 +15,14 @@
 
 #include "tomorig/stream/frame_receiver.h"
 #include "tomorig/stream/frame_sender.h"
+#include "tomorig/stream/receive_memory.h"
 
 namespace {
 using namespace std::chrono_literals;
+
+// As `tomorig record` does, before main() starts any thread: received parts reuse freed
+// memory instead of fresh pages.
+const bool kept_receive_buffers = tomorig::stream::keep_receive_buffers();
 
 constexpr int kCameras = 4;
 constexpr int kSide = 2048;

@@ -2,6 +2,12 @@
 // assembly as in `tomorig run`, but the sets leave over the lossless ZeroMQ stream (PUSH) for a
 // `tomorig record` in another process, possibly on another host. It binds by default (the
 // recorder connects); a full recorder slows acquisition down (back-pressure), it never drops.
+//
+// The stream carries the session as well as the sets: a session start (rig file, cameras with
+// pixel pitch, the simulator's truth) goes out first, and the rig only starts once a recorder
+// has taken it; each simulated set's truth goes just before the set; an end-of-acquisition
+// message closes the session, so the recorder writes what `tomorig run` writes and stops by
+// itself.
 #include <cerrno>
 #include <chrono>
 #include <memory>
@@ -13,17 +19,36 @@
 #include <zmq.hpp>
 
 #include "commands.h"
-#include "record_layout.h"
-#include "rig_acquisition.h"
-#include "rig_run_options.h"
-#include "send_with_retry.h"
-#include "rig_status.h"
-#include "stop_signal.h"
+#include "tomorig/rig/record_layout.h"
+#include "tomorig/rig/rig_acquisition.h"
+#include "tomorig/rig/rig_run_options.h"
+#include "tomorig/rig/rig_session_info.h"
+#include "tomorig/rig/send_with_retry.h"
+#include "tomorig/rig/rig_status.h"
+#include "tomorig/rig/stop_signal.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
 #include "tomorig/stream/frame_sender.h"
 
 namespace tomorig::app {
+
+using rig::rig_session_info;
+using rig::LossTally;
+using rig::RigAcquisition;
+using rig::RigAcquisitionOptions;
+using rig::RigProgress;
+using rig::RigRunChoices;
+using rig::SendOutcome;
+using rig::StatusFigures;
+using rig::StatusReporter;
+using rig::StopSignalGuard;
+using rig::add_rig_run_options;
+using rig::load_rig;
+using rig::rig_acquisition_options;
+using rig::run_length_text;
+using rig::send_with_retry;
+using rig::pixel_bytes;
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -44,7 +69,8 @@ void acquire(const AcquireOptions& opt) {
     throw bad_input(fmt::format("--timeout {:g} / --wait {:g} are invalid: both must be > 0 seconds", opt.timeout_s,
                                 opt.wait_s));
   const config::RigConfig rig = load_rig(opt.rig);
-  const RigAcquisitionOptions acquisition = rig_acquisition_options(rig, opt.rig);
+  RigAcquisitionOptions acquisition = rig_acquisition_options(rig, opt.rig);
+  acquisition.keep_truth = true;  // simulated rigs: the recorder gets the truth `run` would write
   RigAcquisition rig_run(rig, acquisition);  // a bad rig fails here, before anything is sent
 
   StopSignalGuard stop;
@@ -72,6 +98,16 @@ void acquire(const AcquireOptions& opt) {
     status.update(figures, losses, final);
   };
   std::string stopped_by;
+  stream::SessionStart session;
+  session.session_id = stream::new_session_id();
+  session.info = rig_session_info(rig, rig_run);
+  session.truth = rig_run.session_truth();
+  // Waits (up to --wait) for a recorder before the trigger fires, so no set queues up
+  // unrecorded meanwhile; Ctrl-C while waiting ends the command with nothing acquired.
+  if (send_with_retry(*sender, session, opt.wait_s, &stop) == SendOutcome::stopped) {
+    fmt::print("no recorder took the session start; stopped by {} before acquiring\n", stop.signal_name());
+    return;
+  }
   rig_run.start();
   while (!rig_run.done()) {
     for (const auto& text : rig_run.take_notices()) {
@@ -88,10 +124,12 @@ void acquire(const AcquireOptions& opt) {
       refresh(false);
       continue;
     }
-    const bool first = sender->stats().sets_sent == 0;
+    if (auto truth = rig_run.take_truth(set->trigger_index))
+      send_with_retry(*sender, stream::SetTruth{session.session_id, set->trigger_index, std::move(*truth)},
+                      opt.timeout_s, nullptr);
     // Ctrl-C interrupts a wait for the recorder; the set in hand and those already acquired
     // still go out, each with the normal timeout.
-    if (send_with_retry(*sender, *set, first ? opt.wait_s : opt.timeout_s, stopped_by.empty() ? &stop : nullptr) ==
+    if (send_with_retry(*sender, *set, opt.timeout_s, stopped_by.empty() ? &stop : nullptr) ==
         SendOutcome::stopped) {
       stopped_by = stop.signal_name();
       figures.state = "stopping";
@@ -105,6 +143,25 @@ void acquire(const AcquireOptions& opt) {
   }
   for (const auto& text : rig_run.take_notices()) fmt::print(stderr, "acquire: {}\n", text);
   rig_run.request_stop();
+
+  // The end of acquisition: the recorder closes its file when it has every set sent before.
+  stream::SessionEnd end;
+  end.session_id = session.session_id;
+  end.sets_sent = sender->stats().sets_sent;
+  if (!rig_run.failure().empty()) {
+    end.outcome = stream::SessionOutcome::failed;
+    end.reason = rig_run.failure();
+  } else if (!stopped_by.empty()) {
+    end.outcome = stream::SessionOutcome::stopped;
+    end.reason = "stopped by " + stopped_by;
+  }
+  try {
+    send_with_retry(*sender, end, opt.timeout_s, nullptr);
+  } catch (const Error& e) {
+    if (stopped_by.empty()) throw;
+    // Stopped by the operator, typically after the recorder: nobody is left to tell.
+    fmt::print(stderr, "acquire: {}\n", e.what());
+  }
 
   // Hand every queued set to the transport: closing the context waits (up to one --timeout of
   // linger) until ZeroMQ has written them to the recorder.
@@ -131,7 +188,9 @@ void add_acquire_command(CLI::App& root) {
   cmd->add_flag("--allow-remote", opt->allow_remote, "Allow binding --to on a non-loopback address");
   cmd->add_option("--timeout", opt->timeout_s, "Seconds a send may wait for the recorder before giving up")
       ->capture_default_str();
-  cmd->add_option("--wait", opt->wait_s, "Seconds to wait for a recorder before the first set")->capture_default_str();
+  cmd->add_option("--wait", opt->wait_s, "Seconds to wait for a recorder to take the session start (the trigger "
+                                        "starts after it)")
+      ->capture_default_str();
   cmd->callback([opt] { acquire(*opt); });
 }
 

@@ -20,16 +20,29 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "calibrate_images.h"
+#include "tomorig/pipeline/target_images.h"
 #include "calibrate_report.h"
 #include "commands.h"
-#include "correspondence_csv.h"
+#include "tomorig/pipeline/correspondence_csv.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/calibration/calibration_file.h"
 #include "tomorig/processing/calibration/fit_camera_model.h"
 #include "tomorig/processing/calibration/traverse_correction.h"
 
 namespace tomorig::app {
+
+using pipeline::CorrespondenceTable;
+using pipeline::DetectedTargets;
+using pipeline::TargetImage;
+using pipeline::TargetImageSet;
+using pipeline::detect_targets;
+using pipeline::find_target_images;
+using pipeline::orient_y_axis;
+using pipeline::read_correspondence_csv;
+using pipeline::read_image_list;
+using pipeline::read_session_targets;
+using pipeline::write_correspondence_csv;
+
 namespace {
 
 struct CalibrateArgs {

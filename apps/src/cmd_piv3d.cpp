@@ -11,12 +11,18 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
-#include "process_correlation.h"
+#include "tomorig/pipeline/correlation_args.h"
 #include "tomorig/core/error.h"
 #include "tomorig/storage/results_file.h"
 #include "tomorig/storage/volume_file.h"
 
 namespace tomorig::app {
+
+using pipeline::CorrelationArgs;
+using pipeline::add_correlation_flags;
+using pipeline::correlation_options;
+using pipeline::to_json;
+
 namespace {
 
 struct Piv3dArgs {

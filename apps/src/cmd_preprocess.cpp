@@ -16,7 +16,7 @@
 #include <fmt/core.h>
 
 #include "commands.h"
-#include "process_preprocess.h"
+#include "tomorig/pipeline/session_preprocessor.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/preprocess/chain_spec.h"
 #include "tomorig/processing/preprocess/image_chain.h"
@@ -24,6 +24,9 @@
 #include "tomorig/storage/session_file.h"
 
 namespace tomorig::app {
+
+using pipeline::reference_image;
+
 namespace {
 
 namespace fs = std::filesystem;

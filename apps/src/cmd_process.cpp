@@ -19,14 +19,14 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
-#include "process_correlation.h"
-#include "process_pipeline.h"
-#include "process_preprocess.h"
+#include "tomorig/pipeline/correlation_args.h"
+#include "tomorig/pipeline/two_stage_pipeline.h"
+#include "tomorig/pipeline/session_preprocessor.h"
 #include "process_progress.h"
-#include "process_slice_png.h"
-#include "report_json.h"
-#include "session_geometry.h"
-#include "stop_signal.h"
+#include "tomorig/pipeline/slice_png.h"
+#include "tomorig/pipeline/report_json.h"
+#include "tomorig/pipeline/session_geometry.h"
+#include "tomorig/rig/stop_signal.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/reconstruction/reconstructor.h"
@@ -35,6 +35,20 @@
 #include "tomorig/storage/session_file.h"
 
 namespace tomorig::app {
+
+using pipeline::CorrelationArgs;
+using pipeline::ReconstructionSetup;
+using pipeline::SessionCameras;
+using pipeline::SessionPreprocessor;
+using pipeline::TwoStagePipeline;
+using pipeline::add_correlation_flags;
+using pipeline::correlation_options;
+using pipeline::reconstruction_setup;
+using pipeline::session_cameras;
+using pipeline::to_json;
+using pipeline::write_slice_png;
+using rig::StopSignalGuard;
+
 namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;

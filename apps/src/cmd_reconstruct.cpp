@@ -10,8 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
-#include "report_json.h"
-#include "session_geometry.h"
+#include "tomorig/pipeline/report_json.h"
+#include "tomorig/pipeline/session_geometry.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/reconstruction/reconstructor.h"
@@ -20,6 +20,13 @@
 #include "tomorig/storage/volume_file.h"
 
 namespace tomorig::app {
+
+using pipeline::ReconstructionSetup;
+using pipeline::SessionCameras;
+using pipeline::reconstruction_setup;
+using pipeline::session_cameras;
+using pipeline::to_json;
+
 namespace {
 
 struct ReconstructArgs {

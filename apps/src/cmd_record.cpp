@@ -1,7 +1,9 @@
 // tomorig record: the recorder half of a split rig. Pulls FrameSets from the lossless stream
 // (tomorig replay, or an acquisition process) and writes them live (HDF5 SWMR) into a session
 // file, so the file can be inspected while it grows and survives a crash. It connects by
-// default; the sender binds.
+// default; the sender binds. The sender's session start gives the file the rig config, pixel
+// pitch and truth a `tomorig run` file has, and its end-of-acquisition message ends the
+// recording (docs/wire-protocol.md, "Session messages").
 #include <unistd.h>
 
 #include <cerrno>
@@ -16,13 +18,21 @@
 #include <zmq.hpp>
 
 #include "commands.h"
-#include "record_layout.h"
-#include "stop_signal.h"
+#include "tomorig/rig/record_layout.h"
+#include "tomorig/rig/stop_signal.h"
+#include "tomorig/rig/stream_session.h"
 #include "tomorig/core/error.h"
 #include "tomorig/storage/session_file.h"
 #include "tomorig/stream/frame_receiver.h"
+#include "tomorig/stream/receive_memory.h"
 
 namespace tomorig::app {
+
+using rig::StreamSession;
+using rig::StopSignalGuard;
+using rig::set_matches_cameras;
+using rig::pixel_bytes;
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -52,6 +62,7 @@ double seconds_since(Clock::time_point t) { return duration<double>(Clock::now()
 
 struct RecordCounts {
   std::uint64_t written = 0;
+  std::uint64_t received = 0;  // frame sets of the recorded session that arrived (written or refused)
   std::uint64_t bytes_written = 0;
   std::uint64_t refused = 0;   // sets whose cameras or sizes differ from the session's
   std::uint64_t rejected = 0;  // messages the decoder refused
@@ -71,10 +82,17 @@ class RecordStatus {
                tty_ ? "\r" : "", c.written, mbps, r.sets_missing, c.refused, c.rejected, tty_ && !final ? "   " : "\n");
     last_ = now;
     last_bytes_ = c.bytes_written;
+    line_open_ = tty_ && !final;
+  }
+  // Ends a line rewritten in place, so another message starts on a fresh line.
+  void break_line() {
+    if (line_open_) fmt::print(stderr, "\n");
+    line_open_ = false;
   }
 
  private:
   bool tty_;
+  bool line_open_ = false;
   Clock::time_point last_;
   std::uint64_t last_bytes_ = 0;
 };
@@ -103,6 +121,9 @@ void record(const RecordOptions& opt) {
   const std::filesystem::path out(opt.out);
   check_output(opt, out);
 
+  // Received parts reuse freed memory instead of fresh pages (the receiving CPU cost per GB
+  // drops by about half on loopback TCP); must precede the ZeroMQ context.
+  stream::keep_receive_buffers();
   StopSignalGuard stop;
   zmq::context_t context(1);
   stream::SocketOptions socket;
@@ -120,6 +141,13 @@ void record(const RecordOptions& opt) {
   writer_options.disk_reserve_bytes = static_cast<std::uint64_t>(opt.disk_reserve_mb * 1e6);
   std::unique_ptr<storage::SessionWriter> writer;
   std::vector<storage::SessionCamera> cameras;
+  StreamSession session;
+  auto open_writer = [&](std::vector<storage::SessionCamera> session_cameras) {
+    cameras = session_cameras;
+    writer = std::make_unique<storage::SessionWriter>(
+        out, session.file_info(std::move(session_cameras), receiver.endpoint()), writer_options);
+    if (session.announced() && session.announced()->truth) writer->write_truth(*session.announced()->truth);
+  };
 
   RecordCounts counts;
   RecordStatus status;
@@ -127,15 +155,16 @@ void record(const RecordOptions& opt) {
     if (++counter <= kPrintedRefusals) fmt::print(stderr, "record: {} {}: {}\n", what, index, why);
   };
   std::string stopped_by;
+  std::string new_session;  // set when another session started while this one was recorded
   auto last_arrival = Clock::now();
   while (!opt.sets || counts.written < *opt.sets) {
     if (stop.stop_requested()) {
       stopped_by = stop.signal_name();
       break;
     }
-    std::optional<FrameSet> set;
+    std::optional<stream::StreamMessage> message;
     try {
-      set = receiver.receive();
+      message = receiver.receive_message();
     } catch (const zmq::error_t& e) {
       if (e.num() == EINTR) continue;  // a signal: the loop head decides
       throw runtime_error(fmt::format("receiving from {} failed: {}", receiver.endpoint(), e.what()));
@@ -143,7 +172,7 @@ void record(const RecordOptions& opt) {
       refuse(counts.rejected, "rejected message", receiver.stats().rejected_messages, e.what());
       continue;
     }
-    if (!set) {
+    if (!message) {
       if (opt.idle_timeout_s && seconds_since(last_arrival) >= *opt.idle_timeout_s) {
         stopped_by = fmt::format("no set for {:g} s (--idle-timeout)", *opt.idle_timeout_s);
         break;
@@ -152,26 +181,51 @@ void record(const RecordOptions& opt) {
       continue;
     }
     last_arrival = Clock::now();
+
+    if (auto* start = std::get_if<stream::SessionStart>(&*message)) {
+      const std::uint64_t id = start->session_id;
+      const auto outcome = session.on_start(std::move(*start), writer != nullptr);
+      if (outcome == StreamSession::StartOutcome::conflict) {
+        new_session = fmt::format("{:016x}", id);
+        break;
+      }
+      if (outcome == StreamSession::StartOutcome::adopted) {
+        const stream::SessionStart& s = *session.announced();
+        status.break_line();
+        fmt::print(stderr, "record: session {:016x} from tomorig {}: {} cameras, rig config {} bytes{}\n", id,
+                   s.info.software_version.empty() ? "(unknown version)" : s.info.software_version,
+                   s.info.cameras.size(), s.info.rig_config_toml.size(), s.truth ? ", with truth" : "");
+        if (auto known = session.cameras_known_in_advance()) open_writer(std::move(*known));
+      }
+      continue;
+    }
+    if (auto* truth = std::get_if<stream::SetTruth>(&*message)) {
+      session.on_truth(std::move(*truth));
+      continue;
+    }
+    if (auto* end = std::get_if<stream::SessionEnd>(&*message)) {
+      if (session.on_end(*end)) break;
+      continue;  // the end of a session this recorder never saw start
+    }
+
+    FrameSet& set = std::get<FrameSet>(*message);
+    ++counts.received;
     std::string why;
     if (!writer) {
-      auto learned = cameras_from_set(*set, why);
+      auto learned = session.cameras_from_first_set(set, why);
       if (!learned) {
-        refuse(counts.refused, "refused set", set->set_index, "it cannot start the session: " + why);
+        refuse(counts.refused, "refused set", set.set_index, "it cannot start the session: " + why);
         continue;
       }
-      cameras = std::move(*learned);
-      storage::SessionInfo info;
-      info.cameras = cameras;
-      info.rig_config_toml = fmt::format(
-          "# recorded by 'tomorig record' from {}; the stream does not carry the rig configuration\n",
-          receiver.endpoint());
-      writer = std::make_unique<storage::SessionWriter>(out, info, writer_options);
-    } else if (!set_matches_cameras(*set, cameras, why)) {
-      refuse(counts.refused, "refused set", set->set_index, why);
+      open_writer(std::move(*learned));
+    }
+    if (!set_matches_cameras(set, cameras, why)) {
+      refuse(counts.refused, "refused set", set.set_index, why);
       continue;
     }
     try {
-      writer->append(*set);
+      writer->append(set);
+      if (auto truth = session.take_truth(set.trigger_index)) writer->write_truth_set(counts.written, *truth);
     } catch (const storage::DiskFullError& e) {
       // Nothing of this set was written: close the session cleanly with every set before it.
       status.update(counts, receiver.stats(), /*final=*/true);
@@ -187,9 +241,9 @@ void record(const RecordOptions& opt) {
                                       counts.written, e.what(), writer->partial_path().string()));
     }
     ++counts.written;
-    counts.bytes_written += pixel_bytes(*set);
+    counts.bytes_written += pixel_bytes(set);
     if (opt.verbose)
-      fmt::print(stderr, "record: wrote set {} (trigger {}) as set {}\n", set->set_index, set->trigger_index,
+      fmt::print(stderr, "record: wrote set {} (trigger {}) as set {}\n", set.set_index, set.trigger_index,
                  counts.written - 1);
     status.update(counts, receiver.stats());
   }
@@ -199,12 +253,30 @@ void record(const RecordOptions& opt) {
   if (!writer)
     throw runtime_error(fmt::format("no usable frame set arrived from {} ({}); nothing was recorded. Is the sender "
                                     "running, and does one side bind and the other connect?",
-                                    receiver.endpoint(), stopped_by.empty() ? "stopped" : stopped_by));
+                                    receiver.endpoint(),
+                                    session.ended() ? "the sender ended its session without a set"
+                                    : stopped_by.empty() ? "stopped"
+                                                         : stopped_by));
   writer->finish();
+  const auto& end = session.ended();
+  std::string ending;
+  if (end)
+    ending = fmt::format("; the sender ended the session: {}{}", to_string(end->outcome),
+                         end->reason.empty() ? "" : " (" + end->reason + ")");
+  else if (!stopped_by.empty())
+    ending = "; stopped: " + stopped_by;
   fmt::print("recorded {} sets ({:.1f} MB of pixels) to {}; {} lost sets, {} refused sets, {} rejected messages{}\n",
              counts.written, static_cast<double>(counts.bytes_written) / 1e6, out.string(), received.sets_missing,
-             counts.refused, counts.rejected, stopped_by.empty() ? "" : "; stopped: " + stopped_by);
+             counts.refused, counts.rejected, ending);
   fmt::print("next: tomorig inspect {}\n", out.string());
+  if (end && end->sets_sent > counts.received)
+    throw runtime_error(fmt::format("{} of the {} sets the sender sent never arrived; {} is complete with the {} that "
+                                    "were recorded",
+                                    end->sets_sent - counts.received, end->sets_sent, out.string(), counts.written));
+  if (!new_session.empty())
+    throw runtime_error(fmt::format("another session ({}) started on {} before the end of the one being recorded; {} "
+                                    "is complete with {} sets. Record the next session with another -o",
+                                    new_session, receiver.endpoint(), out.string(), counts.written));
 }
 
 }  // namespace
@@ -218,7 +290,8 @@ void add_record_command(CLI::App& root) {
   cmd->add_flag("--bind", opt->bind, "Bind --from instead of connecting (then the sender connects)");
   cmd->add_flag("--allow-remote", opt->allow_remote, "Allow --bind on a non-loopback address");
   cmd->add_option("-o,--out", opt->out, "Session file to write (.h5)")->required();
-  cmd->add_option("--sets", opt->sets, "Stop after this many sets (default: until Ctrl-C or --idle-timeout)");
+  cmd->add_option("--sets", opt->sets,
+                  "Stop after this many sets (default: at the sender's end of acquisition, Ctrl-C or --idle-timeout)");
   cmd->add_option("--compression", opt->compression, "Frame compression: none | bitshuffle-lz4")
       ->capture_default_str();
   cmd->add_option("--idle-timeout", opt->idle_timeout_s, "Stop when no set arrived for this many seconds");

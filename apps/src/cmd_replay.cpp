@@ -1,6 +1,9 @@
 // tomorig replay: publishes a recorded session's FrameSets on the lossless stream (PUSH), as
 // an acquisition process would, so that a recorder or a processing back end can be run and
 // tested without a rig. Replay binds by default and the receiver (tomorig record) connects.
+// Like `tomorig acquire` it frames the sets with a session start (the file's rig config,
+// cameras, software version, creation time and truth), each set's truth just before the set,
+// and an end of acquisition, so replay -> record copies a session faithfully.
 #include <unistd.h>
 
 #include <cerrno>
@@ -14,14 +17,25 @@
 #include <zmq.hpp>
 
 #include "commands.h"
-#include "replay_schedule.h"
-#include "send_with_retry.h"
-#include "stop_signal.h"
+#include "tomorig/rig/replay_schedule.h"
+#include "tomorig/rig/send_with_retry.h"
+#include "tomorig/rig/stop_signal.h"
 #include "tomorig/core/error.h"
 #include "tomorig/storage/session_file.h"
 #include "tomorig/stream/frame_sender.h"
 
 namespace tomorig::app {
+
+using rig::ReplayRate;
+using rig::ReplaySchedule;
+using rig::SendOutcome;
+using rig::SetRange;
+using rig::StopSignalGuard;
+using rig::make_replay_schedule;
+using rig::parse_replay_rate;
+using rig::parse_set_range;
+using rig::send_with_retry;
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -92,9 +106,16 @@ void replay(const ReplayOptions& opt) {
              sender->endpoint(), range.first, range.last - 1, opt.file, opt.rate, opt.loop ? ", looping" : "");
   std::fflush(stderr);
 
+  stream::SessionStart start;
+  start.session_id = stream::new_session_id();
+  start.info = session.info();
+  if (session.has_truth()) start.truth = session.truth();
+
   ReplayStatus status;
   std::uint64_t blocked_sets = 0;
-  bool stopped = false;
+  // The first message waits (up to --wait) for a receiver.
+  const bool announced = send_with_retry(*sender, start, opt.wait_s, &stop) == SendOutcome::sent;
+  bool stopped = !announced;
   auto pass_start = Clock::now();
   do {
     for (std::uint64_t i = range.first; i < range.last && !stopped; ++i) {
@@ -103,14 +124,33 @@ void replay(const ReplayOptions& opt) {
       FrameSet set = session.read_set(i);
       set.set_index = i;
       const std::uint64_t blocked_before = sender->stats().blocked_sends;
-      const bool first = sender->stats().sets_sent == 0;
-      stopped = send_with_retry(*sender, set, first ? opt.wait_s : opt.timeout_s, &stop) == SendOutcome::stopped;
+      if (session.has_truth_set(i))
+        send_with_retry(*sender, stream::SetTruth{start.session_id, set.trigger_index, session.truth_set(i)},
+                        opt.timeout_s, nullptr);
+      stopped = send_with_retry(*sender, set, opt.timeout_s, &stop) == SendOutcome::stopped;
       if (sender->stats().blocked_sends != blocked_before) ++blocked_sets;
       status.update(sender->stats(), blocked_sets);
     }
     pass_start = rate.mode == ReplayRate::Mode::max ? Clock::now() : pass_start + schedule.pass_length;
   } while (opt.loop && !stopped && !stop.stop_requested());
   stopped = stopped || stop.stop_requested();
+  if (announced) {
+    // The end of the session: the recorder closes its file once it has the sets sent before.
+    stream::SessionEnd end;
+    end.session_id = start.session_id;
+    end.sets_sent = sender->stats().sets_sent;
+    if (stopped) {
+      end.outcome = stream::SessionOutcome::stopped;
+      end.reason = fmt::format("replay stopped by {}", stop.signal_name());
+    }
+    try {
+      send_with_retry(*sender, end, opt.timeout_s, nullptr);
+    } catch (const Error& e) {
+      if (!stopped) throw;
+      // Stopped by the operator, typically after the recorder: nobody is left to tell.
+      fmt::print(stderr, "replay: {}\n", e.what());
+    }
+  }
 
   // Hand every queued set to the transport: closing the context waits (up to the linger, one
   // --timeout) until ZeroMQ has written all queued messages to the receiver. Waiting the whole
@@ -149,7 +189,7 @@ void add_replay_command(CLI::App& root) {
   cmd->add_option("--timeout", opt->timeout_s, "Seconds a send may wait for the receiver before giving up")
       ->capture_default_str();
   cmd->add_option("--wait", opt->wait_s,
-                  "Seconds to wait for a receiver before the first set (at least one --timeout)")->capture_default_str();
+                  "Seconds to wait for a receiver to take the session start, the first message")->capture_default_str();
   cmd->callback([opt] { replay(*opt); });
 }
 

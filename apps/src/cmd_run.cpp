@@ -21,19 +21,36 @@
 #include <zmq.hpp>
 
 #include "commands.h"
-#include "record_layout.h"
-#include "rig_acquisition.h"
-#include "rig_run_options.h"
-#include "rig_status.h"
-#include "stop_signal.h"
+#include "tomorig/rig/record_layout.h"
+#include "tomorig/rig/rig_acquisition.h"
+#include "tomorig/rig/rig_run_options.h"
+#include "tomorig/rig/rig_session_info.h"
+#include "tomorig/rig/rig_status.h"
+#include "tomorig/rig/stop_signal.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
-#include "tomorig/core/version.h"
 #include "tomorig/storage/session_file.h"
 #include "tomorig/stream/frame_receiver.h"
 #include "tomorig/stream/frame_sender.h"
 
 namespace tomorig::app {
+
+using rig::complete_announced_cameras;
+using rig::rig_session_info;
+using rig::LossTally;
+using rig::RigAcquisition;
+using rig::RigAcquisitionOptions;
+using rig::RigProgress;
+using rig::RigRunChoices;
+using rig::StatusFigures;
+using rig::StatusReporter;
+using rig::StopSignalGuard;
+using rig::add_rig_run_options;
+using rig::load_rig;
+using rig::rig_acquisition_options;
+using rig::run_length_text;
+using rig::pixel_bytes;
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -137,10 +154,7 @@ void run(const RunOptions& opt) {
   zmq::context_t context(1);
   StatusReporter status("recording", context, opt.rig.status);
 
-  storage::SessionInfo info;
-  info.cameras = rig_run.session_cameras();
-  info.rig_config_toml = rig.source_text;
-  info.software_version = std::string(software_version());
+  storage::SessionInfo info = rig_session_info(rig, rig_run);
   storage::SessionWriterOptions writer_options;
   writer_options.live = true;
   writer_options.compression = *compression;
@@ -219,7 +233,7 @@ void run(const RunOptions& opt) {
     losses.add(*set);
     if (!writer) {
       std::string why;
-      auto cameras = cameras_from_set(*set, why);
+      auto cameras = complete_announced_cameras(info.cameras, *set, why);
       if (!cameras) continue;  // counted in the losses; a later complete set starts the session
       info.cameras = std::move(*cameras);
       open_writer();

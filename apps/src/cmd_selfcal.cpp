@@ -14,13 +14,20 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
-#include "session_geometry.h"
+#include "tomorig/pipeline/session_geometry.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/calibration/calibration_file.h"
 #include "tomorig/processing/calibration/self_calibration.h"
 #include "tomorig/storage/session_file.h"
 
 namespace tomorig::app {
+
+using pipeline::SessionCameras;
+using pipeline::grid_from_session;
+using pipeline::parse_grid;
+using pipeline::session_cameras;
+using pipeline::truth_cameras;
+
 namespace {
 
 constexpr std::uint64_t kDefaultSetLimit = 10;

@@ -11,8 +11,8 @@
 #include <fmt/core.h>
 
 #include "commands.h"
-#include "simulate_calib_target.h"
-#include "simulate_session.h"
+#include "tomorig/rig/simulate_calib_target.h"
+#include "tomorig/rig/simulate_session.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
 #include "tomorig/simulators/calibration_target.h"
@@ -20,6 +20,11 @@
 #include "tomorig/storage/session_file.h"
 
 namespace tomorig::app {
+
+using rig::SimulationSummary;
+using rig::run_simulation_to_session;
+using rig::write_calib_target_session;
+
 namespace {
 
 struct SimulateFlags {

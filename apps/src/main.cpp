@@ -8,6 +8,7 @@
 
 #include "commands.h"
 #include "exit_codes.h"
+#include "tomorig/bench/bench_command.h"
 #include "tomorig/core/error.h"
 #include "tomorig/core/version.h"
 
@@ -32,7 +33,7 @@ int main(int argc, char** argv) {
   add_config_command(app);
   add_process_command(app);
   add_piv3d_command(app);
-  add_bench_command(app);
+  tomorig::bench::add_bench_command(app);
   add_trigger_command(app);
 
   try {

@@ -1,6 +1,7 @@
 #pragma once
 // Little-endian field writer and bounds-checked reader for the wire header. Bytes are assembled
 // one by one, so the layout is the same whatever the host's endianness or alignment.
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -21,6 +22,7 @@ class ByteWriter {
   void u32(std::uint32_t v) { put(v, 4); }
   void u64(std::uint64_t v) { put(v, 8); }
   void i64(std::int64_t v) { put(static_cast<std::uint64_t>(v), 8); }
+  void f64(double v) { put(std::bit_cast<std::uint64_t>(v), 8); }  // IEEE 754 binary64
   void bytes(const void* data, std::size_t n) {
     if (n == 0) return;
     const std::size_t at = out_.size();
@@ -36,10 +38,11 @@ class ByteWriter {
 };
 
 // Every read checks that the field lies inside the buffer; a short buffer throws bad_input
-// naming the field, so a truncated or lying header can never be read past its end.
+// naming the message and the field, so a truncated or lying header can never be read past its
+// end. `what` names the message in errors ("wire header", "session-start message").
 class ByteReader {
  public:
-  explicit ByteReader(std::span<const std::byte> data) : data_(data) {}
+  explicit ByteReader(std::span<const std::byte> data, const char* what = "wire header") : data_(data), what_(what) {}
 
   std::size_t offset() const { return pos_; }
   std::size_t remaining() const { return data_.size() - pos_; }
@@ -49,6 +52,7 @@ class ByteReader {
   std::uint32_t u32(const char* field) { return static_cast<std::uint32_t>(get(4, field)); }
   std::uint64_t u64(const char* field) { return get(8, field); }
   std::int64_t i64(const char* field) { return static_cast<std::int64_t>(get(8, field)); }
+  double f64(const char* field) { return std::bit_cast<double>(get(8, field)); }
   std::string string(std::size_t n, const char* field) {
     require(n, field);
     std::string s(reinterpret_cast<const char*>(data_.data() + pos_), n);
@@ -59,8 +63,8 @@ class ByteReader {
  private:
   void require(std::size_t n, const char* field) const {
     if (n > remaining())
-      throw bad_input("truncated wire header: field '" + std::string(field) + "' needs " + std::to_string(n) +
-                      " bytes at offset " + std::to_string(pos_) + " but the header has only " +
+      throw bad_input("truncated " + std::string(what_) + ": field '" + std::string(field) + "' needs " +
+                      std::to_string(n) + " bytes at offset " + std::to_string(pos_) + " but the message has only " +
                       std::to_string(data_.size()) + " bytes");
   }
   std::uint64_t get(int n, const char* field) {
@@ -72,6 +76,7 @@ class ByteReader {
   }
 
   std::span<const std::byte> data_;
+  const char* what_;
   std::size_t pos_ = 0;
 };
 

@@ -54,7 +54,8 @@ void check_endpoint(const Endpoint& endpoint) {
   if (endpoint.bind && !endpoint.allow_remote && !is_local_address(a))
     throw bad_input("refusing to bind stream endpoint '" + a +
                     "': it would accept connections from other hosts. Bind to loopback (e.g. tcp://127.0.0.1:" +
-                    "PORT), or set allow_remote = true for this endpoint to expose the stream on purpose");
+                    "PORT), or set allow_remote = true for this endpoint (--allow-remote on the command line) to expose "
+                    "the stream on purpose");
 }
 
 }  // namespace tomorig::stream

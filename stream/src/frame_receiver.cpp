@@ -20,6 +20,14 @@ FrameReceiver::FrameReceiver(zmq::context_t& context, SocketOptions options)
 FrameReceiver::~FrameReceiver() = default;
 
 std::optional<FrameSet> FrameReceiver::receive() {
+  for (;;) {
+    std::optional<StreamMessage> message = receive_message();
+    if (!message) return std::nullopt;
+    if (auto* set = std::get_if<FrameSet>(&*message)) return std::move(*set);
+  }
+}
+
+std::optional<StreamMessage> FrameReceiver::receive_message() {
   auto parts = detail::receive_multipart(impl_->opened.socket);
   if (!parts) {
     ++impl_->stats.timeouts;
@@ -27,20 +35,26 @@ std::optional<FrameSet> FrameReceiver::receive() {
   }
   std::uint64_t bytes = 0;
   for (const auto& p : *parts) bytes += p.size();
-  FrameSet set;
+  StreamMessage message;
   try {
-    set = decode_frame_set(std::move(*parts));
+    message = decode_stream_message(std::move(*parts));
   } catch (const Error&) {
     ++impl_->stats.rejected_messages;
     throw;
   }
-  // A replay loop restarting at 0 is not a loss; only forward jumps are.
-  if (impl_->last_index && set.set_index > *impl_->last_index + 1)
-    impl_->stats.sets_missing += set.set_index - *impl_->last_index - 1;
-  impl_->last_index = set.set_index;
-  ++impl_->stats.sets_received;
   impl_->stats.bytes_received += bytes;
-  return set;
+  auto* set = std::get_if<FrameSet>(&message);
+  if (set == nullptr) {
+    ++impl_->stats.session_messages;
+    if (std::holds_alternative<SessionStart>(message)) impl_->last_index.reset();  // a new session counts from 0
+    return message;
+  }
+  // A replay loop restarting at 0 is not a loss; only forward jumps are.
+  if (impl_->last_index && set->set_index > *impl_->last_index + 1)
+    impl_->stats.sets_missing += set->set_index - *impl_->last_index - 1;
+  impl_->last_index = set->set_index;
+  ++impl_->stats.sets_received;
+  return message;
 }
 
 const std::string& FrameReceiver::endpoint() const { return impl_->opened.endpoint; }

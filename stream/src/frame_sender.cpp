@@ -19,13 +19,36 @@ struct FrameSender::Impl {
 FrameSender::FrameSender(zmq::context_t& context, SocketOptions options)
     : impl_(std::make_unique<Impl>()) {
   // Closing waits up to one timeout so sets already queued still reach the receiver.
-  impl_->opened = detail::open_socket(context, zmq::socket_type::push, options, options.timeout);
+  impl_->opened = detail::open_socket(context, zmq::socket_type::push, options, options.timeout,
+                                      detail::lossless_send_buffer_bytes());
 }
 
 FrameSender::~FrameSender() = default;
 
 bool FrameSender::send(const FrameSet& set) {
   std::vector<zmq::message_t> parts = encode_frame_set(set);
+  return send_parts(parts, 1, fmt::format("set {}", set.set_index));
+}
+
+bool FrameSender::send(const SessionStart& start) {
+  std::vector<zmq::message_t> parts;
+  parts.push_back(encode_session_start(start));
+  return send_parts(parts, 0, "the session start");
+}
+
+bool FrameSender::send(const SetTruth& truth) {
+  std::vector<zmq::message_t> parts;
+  parts.push_back(encode_set_truth(truth));
+  return send_parts(parts, 0, fmt::format("the truth of trigger {}", truth.trigger_index));
+}
+
+bool FrameSender::send(const SessionEnd& end) {
+  std::vector<zmq::message_t> parts;
+  parts.push_back(encode_session_end(end));
+  return send_parts(parts, 0, "the session end");
+}
+
+bool FrameSender::send_parts(std::vector<zmq::message_t>& parts, std::uint64_t frame_sets, const std::string& what) {
   std::uint64_t bytes = 0;
   for (const auto& p : parts) bytes += p.size();
   zmq::socket_t& socket = impl_->opened.socket;
@@ -45,9 +68,9 @@ bool FrameSender::send(const FrameSet& set) {
   }
   for (std::size_t i = 1; i < parts.size(); ++i)
     if (!socket.send(parts[i], flags_for(i)))
-      throw runtime_error(fmt::format("set {} was cut off after part {} of {} on {}; the stream is out of step",
-                                      set.set_index, i, parts.size(), impl_->opened.endpoint));
-  impl_->sets_sent.fetch_add(1);
+      throw runtime_error(fmt::format("{} was cut off after part {} of {} on {}; the stream is out of step", what, i,
+                                      parts.size(), impl_->opened.endpoint));
+  impl_->sets_sent.fetch_add(frame_sets);
   impl_->bytes_sent.fetch_add(bytes);
   return true;
 }

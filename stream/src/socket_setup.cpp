@@ -1,13 +1,37 @@
 #include "socket_setup.h"
 
+#include <algorithm>
+#include <fstream>
+
 #include <fmt/format.h>
 
 #include "tomorig/core/error.h"
 
 namespace tomorig::stream::detail {
 
+namespace {
+
+// The last number of a /proc/sys file ("4096 16384 4194304" -> 4194304), or 0 if unreadable.
+long last_number_in(const char* path) {
+  std::ifstream in(path);
+  long value = 0, last = 0;
+  while (in >> value) last = value;
+  return last;
+}
+
+}  // namespace
+
+int lossless_send_buffer_bytes() {
+  constexpr long kWanted = 8l << 20;
+  const long cap = last_number_in("/proc/sys/net/core/wmem_max");
+  const long autotune_max = last_number_in("/proc/sys/net/ipv4/tcp_wmem");
+  const long asked = std::min(kWanted, cap);
+  // The kernel doubles the size asked for (bookkeeping overhead).
+  return asked > 0 && 2 * asked > autotune_max ? static_cast<int>(asked) : 0;
+}
+
 OpenedSocket open_socket(zmq::context_t& context, zmq::socket_type type, const SocketOptions& options,
-                         std::chrono::milliseconds linger) {
+                         std::chrono::milliseconds linger, int send_buffer_bytes) {
   check_endpoint(options.endpoint);
   if (options.high_water_mark < 1)
     throw bad_input(fmt::format("stream high_water_mark = {} is invalid: it must be >= 1 (sets queued per socket)",
@@ -22,6 +46,7 @@ OpenedSocket open_socket(zmq::context_t& context, zmq::socket_type type, const S
   s.set(zmq::sockopt::sndtimeo, static_cast<int>(options.timeout.count()));
   s.set(zmq::sockopt::rcvtimeo, static_cast<int>(options.timeout.count()));
   s.set(zmq::sockopt::linger, static_cast<int>(linger.count()));
+  if (send_buffer_bytes > 0) s.set(zmq::sockopt::sndbuf, send_buffer_bytes);
   const std::string& address = options.endpoint.address;
   try {
     if (options.endpoint.bind) {

@@ -16,8 +16,17 @@ struct OpenedSocket {
 };
 
 // `linger`: how long closing waits to hand queued messages to the peer (lossless sockets wait,
-// preview and status sockets drop).
+// preview and status sockets drop). `send_buffer_bytes` > 0 sets the kernel send buffer
+// (SO_SNDBUF) of the socket's TCP connections; 0 leaves the kernel's auto-tuning.
 OpenedSocket open_socket(zmq::context_t& context, zmq::socket_type type, const SocketOptions& options,
-                         std::chrono::milliseconds linger);
+                         std::chrono::milliseconds linger, int send_buffer_bytes = 0);
+
+// The SO_SNDBUF for a lossless sender: large camera frames go out in fewer, longer writes
+// when the kernel send buffer is big (measured on loopback: 20-25 % less CPU per GB with
+// 8 MiB than with auto-tuning's 4 MiB). The kernel caps an explicit size at
+// net.core.wmem_max (and doubles it) and stops auto-tuning, so this returns 0 (keep
+// auto-tuning) when the cap would make the buffer smaller than auto-tuning's maximum
+// (net.ipv4.tcp_wmem), e.g. on a stock kernel with wmem_max = 208 KiB.
+int lossless_send_buffer_bytes();
 
 }  // namespace tomorig::stream::detail

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "byte_io.h"
+#include "wire_preamble.h"
 #include "tomorig/core/error.h"
 
 namespace tomorig::stream {
@@ -163,9 +164,7 @@ std::vector<zmq::message_t> encode_frame_set(const FrameSet& set) {
   std::vector<std::byte> header;
   header.reserve(kFixedHeaderBytes + table_bytes + frame_count * kFrameEntryBytes);
   ByteWriter w(header);
-  w.bytes(kWireMagic, 4);
-  w.u16(kWireProtocolVersion);
-  w.u16(static_cast<std::uint16_t>(MessageType::frame_set));
+  detail::write_preamble(w, MessageType::frame_set);
   w.u64(set.set_index);
   w.u64(set.trigger_index);
   w.i64(set.trigger_timestamp_ns);
@@ -197,21 +196,10 @@ FrameSet decode_frame_set(std::vector<zmq::message_t>&& parts) {
   const zmq::message_t& head = parts[0];
   ByteReader r(std::span<const std::byte>(static_cast<const std::byte*>(head.data()), head.size()));
 
-  std::uint8_t magic[4];
-  for (auto& m : magic) m = r.u8("magic");
-  if (std::memcmp(magic, kWireMagic, 4) != 0)
-    throw bad_input(fmt::format("wrong magic {:02x} {:02x} {:02x} {:02x}: not a tomorig frame-set message "
-                                "(expected 'TMRG'); is the peer a tomorig stream?",
-                                magic[0], magic[1], magic[2], magic[3]));
-  const std::uint16_t version = r.u16("version");
-  if (version != kWireProtocolVersion)
-    throw bad_input(fmt::format("the peer speaks tomorig wire protocol version {} but this program speaks version "
-                                "{}; run the same tomorig release on both ends",
-                                version, kWireProtocolVersion));
-  const std::uint16_t type = r.u16("message_type");
+  const std::uint16_t type = detail::read_preamble(r);
   if (type != static_cast<std::uint16_t>(MessageType::frame_set))
-    throw bad_input(fmt::format("message type {} is not a frame set (type {})", type,
-                                static_cast<int>(MessageType::frame_set)));
+    throw bad_input(fmt::format("message type {} ({}) is not a frame set (type {})", type,
+                                detail::message_type_name(type), static_cast<int>(MessageType::frame_set)));
 
   FrameSet set;
   set.set_index = r.u64("set_index");

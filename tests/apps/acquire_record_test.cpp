@@ -8,6 +8,7 @@
 
 #include "child_process.h"
 #include "cli_runner.h"
+#include "session_compare.h"
 #include "tomorig/storage/session_file.h"
 
 namespace tomorig::testing {
@@ -69,6 +70,36 @@ TEST(AcquireRecord, SplitRigRecordsFramesBitIdenticalToTheSimulator) {
   EXPECT_NE(acquire.err().find("acquire: set 3/3"), std::string::npos) << acquire.err();  // the status line
   expect_frames_of(reference, recorded, 3);
   EXPECT_TRUE(storage::SessionReader(recorded).recording_complete());
+}
+
+// The split rig writes the file `tomorig run` writes for the same rig: /config, root
+// attributes, cameras with pixel pitch, the truth of every set, the frames; and record ends by
+// itself at the sender's end of acquisition, with no --sets and no idle timeout to end it.
+TEST(AcquireRecord, SplitRigFileMatchesARunFileOfTheSameRigAndRecordStopsByItself) {
+  if (!tomorig_built()) GTEST_SKIP() << "tomorig binary not built";
+  TempDir dir;
+  const auto run_file = dir / "run.h5";
+  const auto recorded = dir / "recorded.h5";
+  const CliResult run = run_tomorig("run --sets 3 --pace max --status none -o " + shell_quoted(run_file.string()));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+
+  TomorigProcess acquire(
+      {"acquire", "--sets", "3", "--pace", "max", "--to", "tcp://127.0.0.1:*", "--status", "none", "--wait", "30"});
+  const auto line = acquire.wait_for_line("acquire: sending on");
+  ASSERT_TRUE(line) << acquire.err();
+  // A user's command has neither --sets nor --idle-timeout; the generous idle timeout only keeps
+  // a broken build from hanging the test (and its "stopped" message would fail it).
+  TomorigProcess record({"record", "--from", endpoint_from(*line), "-o", recorded.string(), "--idle-timeout", "120"});
+  ASSERT_EQ(record.wait(), 0) << record.err();
+  ASSERT_EQ(acquire.wait(), 0) << acquire.err();
+  EXPECT_NE(record.out().find("recorded 3 sets"), std::string::npos) << record.out();
+  EXPECT_NE(record.out().find("the sender ended the session: completed"), std::string::npos) << record.out();
+  EXPECT_EQ(record.out().find("idle-timeout"), std::string::npos) << record.out();
+  EXPECT_NE(record.err().find("4 cameras"), std::string::npos) << record.err();
+  EXPECT_NE(record.err().find("with truth"), std::string::npos) << record.err();
+
+  expect_same_session_metadata(run_file, recorded, /*same_creation_time=*/false);
+  expect_frames_of(run_file, recorded, 3);
 }
 
 TEST(AcquireRecord, VanishedCameraIsCountedAndRecordedAsMissing) {

@@ -9,6 +9,7 @@
 
 #include "child_process.h"
 #include "cli_runner.h"
+#include "session_compare.h"
 #include "tomorig/storage/session_file.h"
 
 namespace tomorig::testing {
@@ -99,15 +100,36 @@ TEST_F(ReplayRecord, RoundTripIsBitIdentical) {
   expect_same_sets(src, out, 3);
 }
 
+// Replay announces the session it reads, so the copy keeps /config, the attributes (creation
+// time and software version included), pixel pitch and truth, and record stops by itself
+// after the last set.
+TEST_F(ReplayRecord, CopyKeepsConfigAttributesPitchAndTruthAndEndsByItself) {
+  TempDir tmp;
+  const auto src = source();
+  const auto out = tmp / "copy.h5";
+  TomorigProcess replay({"replay", src.string(), "--to", "tcp://127.0.0.1:*", "--rate", "max"});
+  const auto first_line = replay.wait_for_line("sending on");
+  ASSERT_TRUE(first_line) << replay.err();
+  // Only the end of acquisition should end the recording (the idle timeout is a safety net).
+  TomorigProcess record({"record", "--from", endpoint_from(*first_line), "-o", out.string(), "--idle-timeout", "120"});
+  ASSERT_EQ(record.wait(), 0) << record.err();
+  ASSERT_EQ(replay.wait(), 0) << replay.err();
+  EXPECT_NE(record.out().find("the sender ended the session: completed"), std::string::npos) << record.out();
+  expect_same_session_metadata(src, out, /*same_creation_time=*/true);
+  expect_same_sets(src, out, 3);
+}
+
 TEST_F(ReplayRecord, SigintStopsRecordWithACompleteSession) {
   TempDir tmp;
   const auto src = source();
   const auto out = tmp / "out.h5";
 
-  TomorigProcess replay({"replay", src.string(), "--to", "tcp://127.0.0.1:*", "--rate", "max", "--sets", "0:2"});
+  // A looping replay at 1 Hz never ends the session by itself, and its next set comes a second
+  // after set 1: only the signal (or, if the test breaks, the idle timeout) ends the recording.
+  TomorigProcess replay({"replay", src.string(), "--to", "tcp://127.0.0.1:*", "--rate", "1", "--sets", "0:2",
+                         "--loop", "--timeout", "2"});
   const auto first_line = replay.wait_for_line("sending on");
   ASSERT_TRUE(first_line) << replay.err();
-  // No --sets: only the signal (or, if the test breaks, the idle timeout) ends the recording.
   TomorigProcess record({"record", "--from", endpoint_from(*first_line), "-o", out.string(), "--verbose",
                          "--idle-timeout", "60"});
   ASSERT_TRUE(record.wait_for_line("wrote set 0")) << record.err();
@@ -115,6 +137,9 @@ TEST_F(ReplayRecord, SigintStopsRecordWithACompleteSession) {
   record.send_signal(SIGINT);
   ASSERT_EQ(record.wait(), 0) << record.err();
   EXPECT_NE(record.out().find("stopped: SIGINT"), std::string::npos) << record.out();
+  // Replay, stopped with no recorder left, cannot deliver its session end: it says so and
+  // still exits 0 (it was stopped on purpose).
+  replay.send_signal(SIGINT);
   ASSERT_EQ(replay.wait(), 0) << replay.err();
 
   ASSERT_TRUE(std::filesystem::exists(out));
@@ -159,7 +184,7 @@ TEST_F(ReplayRecord, RecordRefusesToBindBeyondLoopback) {
   const auto out = tmp / "x.h5";
   const CliResult r = run_tomorig("record --bind --from tcp://0.0.0.0:5555 -o " + shell_quoted(out.string()));
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.err.find("allow"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--allow-remote"), std::string::npos) << r.err;  // the flag record has
   EXPECT_FALSE(std::filesystem::exists(out));
   EXPECT_FALSE(std::filesystem::exists(out.string() + ".partial"));
 }

@@ -67,6 +67,22 @@ TEST(RunCommand, UnwritableOutputIsBadInputAndLeavesNothingBehind) {
 namespace tomorig::testing {
 namespace {
 
+// A status address run cannot bind is refused with the options, before a file or a device
+// exists; the advice names what run accepts (no allow_remote option exists for --status).
+TEST(RunCommand, RefusedStatusEndpointLeavesNoPartialFile) {
+  if (!tomorig_built()) GTEST_SKIP() << "tomorig binary not built";
+  TempDir tmp;
+  const auto out = tmp / "x.h5";
+  for (const std::string status : {"tcp://0.0.0.0:45558", "udp://nowhere"}) {
+    const CliResult r = run_tomorig("run --sets 1 --status " + status + " --out " + shell_quoted(out.string()));
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find("--status"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("allow_remote"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(out)) << status;
+    EXPECT_FALSE(std::filesystem::exists(out.string() + ".partial")) << status;
+  }
+}
+
 TEST(RunCommandSignals, SigintLeavesACompleteSessionWithTheSetsRecorded) {
   TempDir dir;
   const auto out = dir / "run.h5";

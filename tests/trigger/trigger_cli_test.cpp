@@ -1,6 +1,7 @@
 // End to end: `tomorig trigger plan` as an operator runs it.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <string>
 
@@ -78,6 +79,55 @@ TEST(TriggerCli, InfeasibleTimingExits2) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(r.out.empty()) << r.out;
   EXPECT_NE(r.err.find("longer than the period 200 us"), std::string::npos) << r.err;
+}
+
+// The issue's LED split over two channels: 1000 Hz, 0.6 µs pulses, one channel per pulse, on
+// together 0.12 % of the time against the LED's 0.1 %. Neither `trigger plan` nor `run` may
+// accept it.
+const char* kSplitLed = R"(
+[trigger]
+backend = "simulated"
+rate_hz = 1000.0
+dt_us = 100.0
+[trigger.camera]
+exposure_a_us = 20.0
+exposure_b_us = 500.0
+[[trigger.light_sources]]
+name = "led1"
+kind = "led"
+pulse_width_us = 0.6
+max_rate_hz = 100000.0
+[[trigger.channels]]
+name = "cam"
+role = "camera"
+[[trigger.channels]]
+name = "led_p1"
+role = "light"
+light_source = "led1"
+pulses = "first"
+[[trigger.channels]]
+name = "led_p2"
+role = "light"
+light_source = "led1"
+pulses = "second"
+)";
+
+TEST(TriggerCli, OneLedSplitOverTwoChannelsIsRefusedByPlanAndRun) {
+  TempDir dir;
+  const std::string rig = write(dir, "split.toml", rig_with_trigger(kSplitLed));
+  const CliResult plan = run_tomorig("trigger plan --config '" + rig + "'");
+  EXPECT_EQ(plan.exit_code, 2) << plan.out;
+  EXPECT_EQ(plan.out.find("within the light-source safety limits"), std::string::npos) << plan.out;
+  EXPECT_NE(plan.err.find("max_duty_cycle"), std::string::npos) << plan.err;
+  EXPECT_NE(plan.err.find("0.12 %"), std::string::npos) << plan.err;
+  EXPECT_NE(plan.err.find("'led_p1', 'led_p2' together"), std::string::npos) << plan.err;
+
+  const auto out = (dir / "s.h5").string();
+  const CliResult run = run_tomorig("run --config '" + rig + "' --sets 2 --out '" + out + "'");
+  EXPECT_EQ(run.exit_code, 2) << run.out << run.err;
+  EXPECT_NE(run.err.find("max_duty_cycle"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  EXPECT_FALSE(std::filesystem::exists(out + ".partial"));
 }
 
 TEST(TriggerCli, MissingConfigExits2) {

@@ -10,6 +10,7 @@
 
 #include "tomorig/core/frame_set.h"
 #include "tomorig/stream/endpoint.h"
+#include "tomorig/stream/session_messages.h"
 
 namespace zmq {
 class context_t;
@@ -21,7 +22,8 @@ struct ReceiverStats {
   std::uint64_t sets_received = 0;
   std::uint64_t bytes_received = 0;
   std::uint64_t sets_missing = 0;       // set indices skipped between consecutive sets
-  std::uint64_t rejected_messages = 0;  // malformed messages (decode_frame_set threw)
+  std::uint64_t rejected_messages = 0;  // malformed messages (the decoder threw)
+  std::uint64_t session_messages = 0;   // session start, set truth and session end messages
   std::uint64_t timeouts = 0;           // receive() calls that saw nothing within the timeout
 };
 
@@ -35,7 +37,12 @@ class FrameReceiver {
   // The next set (Images are zero-copy views into the received message), or nullopt if none
   // arrived within options.timeout. A malformed message is consumed whole, counted, and
   // rethrown as tomorig::Error naming the problem; the receiver stays usable.
+  // Session messages in between are skipped (counted in session_messages).
   std::optional<FrameSet> receive();
+  // The next message of any kind: a frame set (as receive() returns it) or a session message
+  // (tomorig/stream/session_messages.h); nullopt after options.timeout. A session start
+  // restarts the count of missing set indices. Malformed messages as for receive().
+  std::optional<StreamMessage> receive_message();
 
   const std::string& endpoint() const;
   // From the receiving thread (unlike FrameSender, the counters are not atomic).

@@ -7,19 +7,22 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "tomorig/core/frame_set.h"
 #include "tomorig/stream/endpoint.h"
+#include "tomorig/stream/session_messages.h"
 
 namespace zmq {
 class context_t;
+class message_t;
 }
 
 namespace tomorig::stream {
 
 struct SenderStats {
   std::uint64_t sets_sent = 0;
-  std::uint64_t bytes_sent = 0;       // header + pixels
+  std::uint64_t bytes_sent = 0;       // header + pixels (and session messages)
   std::uint64_t blocked_sends = 0;    // sends that found the queue full and had to wait
   std::uint64_t timed_out_sends = 0;  // sends given up after the timeout (nothing sent)
 };
@@ -36,6 +39,11 @@ class FrameSender {
   // Sends the set zero-copy; its Images stay leased until ZeroMQ has sent them. Returns false
   // if no receiver made room within options.timeout: nothing was sent.
   bool send(const FrameSet& set);
+  // Session messages (start before the first set, a set's truth just before the set, end after
+  // the last), with the same back-pressure and timeout. Not counted in sets_sent.
+  bool send(const SessionStart& start);
+  bool send(const SetTruth& truth);
+  bool send(const SessionEnd& end);
 
   // The address as bound (tcp://127.0.0.1:* resolved to the real port) or as connected.
   const std::string& endpoint() const;
@@ -47,6 +55,7 @@ class FrameSender {
   void await_blocked_send(std::uint64_t seen) const;
 
  private:
+  bool send_parts(std::vector<zmq::message_t>& parts, std::uint64_t frame_sets, const std::string& what);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -1,0 +1,69 @@
+#pragma once
+// What a reconstruction needs from a session besides its pixels: the camera models, in the
+// session's camera order, and the voxel grid. Shared by `reconstruct`, `bench recon` and the
+// back-end pipeline.
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "tomorig/core/volume.h"
+#include "tomorig/processing/calibration/camera_model.h"
+#include "tomorig/processing/reconstruction/reconstructor.h"
+#include "tomorig/storage/session_file.h"
+
+namespace tomorig::pipeline {
+
+struct SessionCameras {
+  std::vector<std::shared_ptr<const calibration::CameraModel>> models;  // session camera order
+  std::string source;  // "truth of <session>" or the calibration file, for reports
+  std::vector<const calibration::CameraModel*> pointers() const;
+};
+
+// The simulator's exact cameras stored in the session's /truth. Throws tomorig::Error
+// (bad_input) if the session has no truth (then a calibration file is needed) or its truth
+// cameras do not match the session's cameras by id and size.
+SessionCameras truth_cameras(const storage::SessionReader& session);
+
+// The models of a calibration file (docs/calibration.md): its camera i is the session's camera
+// i. Throws tomorig::Error (bad_input) if the file is bad, or its camera count or image sizes
+// disagree with the session's, naming the camera.
+SessionCameras calibration_cameras(const storage::SessionReader& session, const std::filesystem::path& file);
+
+// `calib` empty or "truth": truth_cameras (empty falls back to the rig config's calibration
+// file when the session has no truth); otherwise calibration_cameras.
+SessionCameras session_cameras(const storage::SessionReader& session, const std::string& calib);
+
+// The [grid] of the session's rig config, as a VoxelGrid (the config gives the grid centre;
+// VoxelGrid wants the centre of voxel (0, 0, 0)).
+VoxelGrid grid_from_session(const storage::SessionReader& session);
+
+// "nx,ny,nz,voxel_mm" or "nx,ny,nz,voxel_mm,cx,cy,cz" (cx..cz: grid centre, mm; default 0).
+// Throws tomorig::Error (bad_input) quoting `text` and the expected form.
+VoxelGrid parse_grid(const std::string& text);
+
+// The command-line side of a reconstruction set-up (`reconstruct`, `process`).
+struct ReconstructionChoices {
+  std::string algorithm;  // empty: the default below
+  // true (`reconstruct`): an empty algorithm takes the rig config's processing.algorithm. false
+  // (`process`): the rig's choice is ignored and FMART is the default, as issue 5 asks.
+  bool algorithm_from_rig = true;
+  int iterations = 0;     // 0: the rig config's processing.iterations
+  double relaxation = 1.0;
+  double mlos_threshold = 0.05;
+  int threads = 0;
+  std::string grid;       // empty: the rig config's [grid]; else as parse_grid
+  double sigma_px = 0.5;
+};
+
+// Validated options and an input holding the cameras, grid, PSF and sensor sizes (images left
+// to the caller), from the session's rig config and `choices`. Throws tomorig::Error (bad_input)
+// naming the option that is wrong.
+struct ReconstructionSetup {
+  recon::ReconstructionOptions options;
+  recon::ReconstructionInput input;
+};
+ReconstructionSetup reconstruction_setup(const storage::SessionReader& session, const std::string& session_path,
+                                         const SessionCameras& cameras, const ReconstructionChoices& choices);
+
+}  // namespace tomorig::pipeline

@@ -1,0 +1,17 @@
+#pragma once
+// A picture of one z-slice of a displacement field, for reports: each node a square cell whose
+// grey level is the in-plane displacement magnitude (white = the slice's largest), with a short
+// dark line showing the in-plane direction; invalid nodes are black.
+#include <filesystem>
+#include <vector>
+
+#include "tomorig/core/geometry.h"
+
+namespace tomorig::pipeline {
+
+// `displacement` and `counted` hold nx * ny * nz nodes (x fastest); nodes with counted == 0 are
+// drawn black. Writes an 8-bit PNG through storage::write_png.
+void write_slice_png(const std::filesystem::path& file, int nx, int ny, int nz, int k,
+                     const std::vector<Vec3d>& displacement, const std::vector<bool>& counted, int cell = 24);
+
+}  // namespace tomorig::pipeline

@@ -1,0 +1,165 @@
+#include "tomorig/pipeline/session_geometry.h"
+
+#include <charconv>
+#include <cmath>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "tomorig/config/rig_config.h"
+#include "tomorig/core/error.h"
+#include "tomorig/processing/calibration/calibration_file.h"
+#include "tomorig/processing/calibration/pinhole_camera.h"
+
+namespace tomorig::pipeline {
+namespace {
+
+VoxelGrid centred_grid(int nx, int ny, int nz, double voxel_mm, const Vec3d& centre) {
+  VoxelGrid g = VoxelGrid::centred(nx, ny, nz, voxel_mm);
+  g.origin = {g.origin.x + centre.x, g.origin.y + centre.y, g.origin.z + centre.z};
+  return g;
+}
+
+}  // namespace
+
+std::vector<const calibration::CameraModel*> SessionCameras::pointers() const {
+  std::vector<const calibration::CameraModel*> out;
+  for (const auto& m : models) out.push_back(m.get());
+  return out;
+}
+
+SessionCameras truth_cameras(const storage::SessionReader& session) {
+  const std::string file = session.path().string();
+  if (!session.has_truth())
+    throw bad_input(fmt::format("session '{}' is not simulated, so it has no truth cameras; give a calibration "
+                                "file with --calib",
+                                file));
+  const storage::SessionTruth truth = session.truth();
+  SessionCameras out;
+  out.source = "truth of " + file;
+  for (const storage::SessionCamera& cam : session.info().cameras) {
+    const storage::TruthCamera* match = nullptr;
+    for (const auto& t : truth.cameras)
+      if (t.id == cam.id) match = &t;
+    if (match == nullptr)
+      throw bad_input(fmt::format("session '{}': camera {} has no truth camera; give a calibration file with --calib",
+                                  file, cam.id));
+    if (match->width != cam.width || match->height != cam.height)
+      throw bad_input(fmt::format("session '{}': camera {} is {} x {} but its truth camera is {} x {}", file, cam.id,
+                                  cam.width, cam.height, match->width, match->height));
+    if (match->model != "pinhole")
+      throw bad_input(fmt::format("session '{}': truth camera {} has model '{}'; only 'pinhole' is supported", file,
+                                  cam.id, match->model));
+    calibration::PinholeParameters p;
+    p.fx = match->K[0];
+    p.cx = match->K[2];
+    p.fy = match->K[4];
+    p.cy = match->K[5];
+    p.R = match->R;
+    p.t = match->t;
+    out.models.push_back(std::make_shared<calibration::PinholeCamera>(p));
+  }
+  return out;
+}
+
+SessionCameras calibration_cameras(const storage::SessionReader& session, const std::filesystem::path& file) {
+  const std::vector<calibration::CameraCalibration> cal = calibration::load_calibration(file);
+  const auto& cams = session.info().cameras;
+  if (cal.size() != cams.size())
+    throw bad_input(fmt::format("calibration file '{}' has {} cameras but session '{}' has {}; use the calibration "
+                                "of this rig",
+                                file.string(), cal.size(), session.path().string(), cams.size()));
+  SessionCameras out;
+  out.source = file.string();
+  out.models.resize(cams.size());
+  for (const auto& c : cal) {
+    if (c.id < 0 || static_cast<std::size_t>(c.id) >= cams.size() || out.models[static_cast<std::size_t>(c.id)])
+      throw bad_input(fmt::format("calibration file '{}': camera {} is not one of cameras 0 to {} of the session, or "
+                                  "appears twice",
+                                  file.string(), c.id, cams.size() - 1));
+    const auto& cam = cams[static_cast<std::size_t>(c.id)];
+    if (c.image_size.width != cam.width || c.image_size.height != cam.height)
+      throw bad_input(fmt::format("calibration file '{}': camera {} was calibrated on {} x {} images but session "
+                                  "camera {} is {} x {}",
+                                  file.string(), c.id, c.image_size.width, c.image_size.height, cam.id, cam.width,
+                                  cam.height));
+    out.models[static_cast<std::size_t>(c.id)] = c.model;
+  }
+  return out;
+}
+
+SessionCameras session_cameras(const storage::SessionReader& session, const std::string& calib) {
+  if (calib == "truth") return truth_cameras(session);
+  if (!calib.empty()) return calibration_cameras(session, calib);
+  if (session.has_truth()) return truth_cameras(session);
+  const std::string& toml = session.info().rig_config_toml;
+  if (!toml.empty()) {
+    const config::RigConfig rig = config::parse_rig_config(toml, session.path().string() + ":/config");
+    if (rig.calibration_file) return calibration_cameras(session, *rig.calibration_file);
+  }
+  throw bad_input(fmt::format("session '{}' has neither truth cameras nor a calibration file in its rig config; give "
+                              "one with --calib",
+                              session.path().string()));
+}
+
+VoxelGrid grid_from_session(const storage::SessionReader& session) {
+  const std::string& toml = session.info().rig_config_toml;
+  if (toml.empty())
+    throw bad_input(fmt::format("session '{}' holds no rig config, so no voxel grid; give one with --grid",
+                                session.path().string()));
+  const config::RigConfig rig = config::parse_rig_config(toml, session.path().string() + ":/config");
+  const config::GridConfig& g = rig.grid;
+  return centred_grid(g.nx, g.ny, g.nz, g.voxel_size_mm, {g.origin_mm[0], g.origin_mm[1], g.origin_mm[2]});
+}
+
+VoxelGrid parse_grid(const std::string& text) {
+  std::vector<double> values;
+  std::stringstream in(text);
+  std::string item;
+  auto fail = [&] {
+    throw bad_input(fmt::format("--grid '{}' is not valid: expected nx,ny,nz,voxel_mm or nx,ny,nz,voxel_mm,cx,cy,cz "
+                                "with nx, ny, nz whole numbers > 0 and voxel_mm > 0, e.g. 512,512,160,0.0195",
+                                text));
+  };
+  while (std::getline(in, item, ',')) {
+    double v = 0;
+    const auto [end, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
+    if (ec != std::errc() || end != item.data() + item.size() || !std::isfinite(v)) fail();
+    values.push_back(v);
+  }
+  if (values.size() != 4 && values.size() != 7) fail();
+  for (int i = 0; i < 3; ++i)
+    if (values[i] < 1 || values[i] != std::floor(values[i]) || values[i] > 65535) fail();
+  if (!(values[3] > 0)) fail();
+  const Vec3d centre = values.size() == 7 ? Vec3d{values[4], values[5], values[6]} : Vec3d{};
+  return centred_grid(static_cast<int>(values[0]), static_cast<int>(values[1]), static_cast<int>(values[2]), values[3],
+                      centre);
+}
+
+ReconstructionSetup reconstruction_setup(const storage::SessionReader& session, const std::string& session_path,
+                                         const SessionCameras& cameras, const ReconstructionChoices& choices) {
+  ReconstructionSetup setup;
+  recon::ReconstructionOptions& options = setup.options;
+  options.algorithm = choices.algorithm;
+  options.relaxation = choices.relaxation;
+  options.mlos_threshold = choices.mlos_threshold;
+  options.threads = choices.threads;
+  if (!session.info().rig_config_toml.empty()) {
+    const config::RigConfig rig = config::parse_rig_config(session.info().rig_config_toml, session_path + ":/config");
+    if (options.algorithm.empty() && choices.algorithm_from_rig) options.algorithm = rig.processing.algorithm;
+    options.max_iterations = rig.processing.iterations;
+  }
+  if (options.algorithm.empty()) options.algorithm = "fmart";
+  if (choices.iterations > 0) options.max_iterations = choices.iterations;
+  options.validate();
+
+  recon::ReconstructionInput& input = setup.input;
+  input.cameras = cameras.pointers();
+  input.grid = choices.grid.empty() ? grid_from_session(session) : parse_grid(choices.grid);
+  input.psf.assign(input.cameras.size(), recon::PsfModel::constant(choices.sigma_px));
+  for (const storage::SessionCamera& c : session.info().cameras) input.sensor_sizes.push_back({c.width, c.height});
+  if (!input.psf.empty()) input.psf.front().validate("--sigma-px");
+  return setup;
+}
+
+}  // namespace tomorig::pipeline

@@ -1,0 +1,80 @@
+// JSON form of the quick-look results: the fields a preview client reads, null for what could
+// not be measured, flags as words.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "particle_field.h"
+#include "tomorig/processing/quicklook/json.h"
+
+namespace tomorig::quicklook {
+namespace {
+
+TEST(QuickLookJson, CameraStatisticsCarryEveryFigureAndItsFlag) {
+  testing::FieldSpec spec;
+  spec.ppp = 0.04;
+  spec.sigma_px = 0.625;
+  const Image a = testing::make_field(spec).image;
+  spec.seed = 2;
+  const Image b = testing::make_field(spec).image;
+  QuickLook ql;
+  CameraQuickLook s;
+  ql.analyse(a, b, s);
+  const nlohmann::json j = s;
+  const nlohmann::json back = nlohmann::json::parse(j.dump());  // survives text
+  EXPECT_EQ(back["flag"], "green");
+  EXPECT_EQ(back["energy_balance"]["flag"], "green");
+  EXPECT_DOUBLE_EQ(back["energy_balance"]["value"].get<double>(), s.energy_balance.value);
+  const auto& frame = back["a"];
+  EXPECT_EQ(frame["width"], 512);
+  EXPECT_EQ(frame["full_scale"], 65535);
+  EXPECT_DOUBLE_EQ(frame["particles"]["ppp"]["value"].get<double>(), s.a.ppp.value);
+  EXPECT_EQ(frame["particles"]["ppp"]["flag"], "green");
+  EXPECT_DOUBLE_EQ(frame["particles"]["diameter_px"]["value"].get<double>(), s.a.diameter_px.value);
+  EXPECT_DOUBLE_EQ(frame["particles"]["source_density"]["value"].get<double>(), s.a.source_density.value);
+  EXPECT_DOUBLE_EQ(frame["particles"]["maxima_per_pixel"].get<double>(), s.a.maxima_per_pixel);
+  EXPECT_DOUBLE_EQ(frame["background"]["level"].get<double>(), s.a.background);
+  EXPECT_DOUBLE_EQ(frame["background"]["noise"].get<double>(), s.a.noise);
+  EXPECT_EQ(frame["background"]["map"]["values"].size(), 64u);
+  EXPECT_EQ(frame["saturation"]["map"]["tiles_x"], 8);
+  EXPECT_EQ(frame["saturation"]["fraction"]["flag"], "green");
+  EXPECT_EQ(frame["histogram"]["counts"].size(), 256u);
+  EXPECT_DOUBLE_EQ(frame["histogram"]["bin_width"].get<double>(), 256.0);
+  EXPECT_EQ(frame["focus"]["map"]["values"].size(), 64u);
+  EXPECT_TRUE(frame["percentiles"].contains("p99.9"));
+}
+
+TEST(QuickLookJson, WhatCannotBeMeasuredIsNull) {
+  testing::FieldSpec spec;
+  spec.ppp = 1e-9;  // no particles
+  QuickLook ql;
+  FrameStatistics s;
+  ql.analyse(testing::make_field(spec).image, s);
+  const nlohmann::json j = nlohmann::json::parse(nlohmann::json(s).dump());
+  EXPECT_TRUE(j["particles"]["diameter_px"]["value"].is_null());
+  EXPECT_EQ(j["particles"]["diameter_px"]["flag"], "red");
+  EXPECT_TRUE(j["particles"]["source_density"]["value"].is_null());
+  EXPECT_TRUE(j["focus"]["map"]["values"][0].is_null());
+  EXPECT_EQ(j["flag"], "red");
+}
+
+TEST(QuickLookJson, DtCheckResult) {
+  testing::FieldSpec spec;
+  auto particles = testing::random_particles(spec);
+  const Image a = testing::digitise(testing::render(particles, spec), spec, 1);
+  for (auto& p : particles) p.centre.x += 5.0;
+  const Image b = testing::digitise(testing::render(particles, spec), spec, 2);
+  DtCheck check;
+  DtCheckResult r;
+  check.check(a, b, r);
+  const nlohmann::json j = nlohmann::json::parse(nlohmann::json(r).dump());
+  EXPECT_EQ(j["flag"], "green");
+  EXPECT_EQ(j["windows"].size(), 16u);
+  EXPECT_NEAR(j["displacement_px"]["value"].get<double>(), 5.0, 0.1);
+  EXPECT_NEAR(j["median_dx"].get<double>(), 5.0, 0.1);
+  EXPECT_EQ(j["displacement_histogram"].size(), 32u);
+  EXPECT_TRUE(j["windows"][0]["valid"].get<bool>());
+}
+
+}  // namespace
+}  // namespace tomorig::quicklook
