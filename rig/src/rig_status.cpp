@@ -7,7 +7,7 @@
 #include <fmt/core.h>
 #include <zmq.hpp>
 
-#include "rig_acquisition.h"
+#include "tomorig/rig/rig_acquisition.h"
 #include "tomorig/core/error.h"
 #include "tomorig/stream/status.h"
 
