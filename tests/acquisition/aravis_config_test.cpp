@@ -158,3 +158,42 @@ TEST_F(AravisFakeInterface, LeasedBuffersStayIntactAndReturnToThePoolWhenRelease
 
 }  // namespace
 }  // namespace tomorig::acquisition
+
+// The camera takes the timing plan: frame mode and exposure are written and read back, and a
+// plan the camera cannot meet is refused naming the camera and the feature.
+namespace tomorig::acquisition {
+namespace {
+
+TEST_F(AravisFakeInterface, AnExposureOutsideTheCamerasRangeIsRefusedNamingCameraAndFeature) {
+  AravisCameraOptions opt = free_running();
+  opt.exposure_time_us = 5.0;  // the fake allows 10 us to 10 s
+  AravisCamera cam("cam4", opt);
+  const std::string msg = error_of([&] { cam.configure(fake_config("cam4")); }, ErrorKind::bad_input);
+  EXPECT_TRUE(contains(msg, "cam4")) << msg;
+  EXPECT_TRUE(contains(msg, "ExposureTime")) << msg;  // ExposureTimeAbs on the fake
+  EXPECT_TRUE(contains(msg, "out of range")) << msg;
+
+  opt.exposure_time_us = 1500.0;  // inside the range: written and read back without complaint
+  AravisCamera ok("cam5", opt);
+  EXPECT_NO_THROW(ok.configure(fake_config("cam5")));
+}
+
+TEST_F(AravisFakeInterface, HardwareFrameModeOnASingleFrameCameraIsRefusedNamingTriggerSelector) {
+  AravisCameraOptions opt;
+  opt.frame_mode = config::FrameMode::hardware;  // the fake offers no frame burst
+  opt.trigger_source = "Software";
+  AravisCamera cam("cam6", opt);
+  const std::string msg = error_of([&] { cam.configure(fake_config("cam6")); }, ErrorKind::bad_input);
+  EXPECT_TRUE(contains(msg, "cam6")) << msg;
+  EXPECT_TRUE(contains(msg, "TriggerSelector")) << msg;
+  EXPECT_TRUE(contains(msg, "two_triggers")) << msg;
+  EXPECT_EQ(cam.triggers_per_set(), 1);
+  AravisCameraOptions two = opt;
+  two.frame_mode = config::FrameMode::two_triggers;
+  AravisCamera single("cam7", two);
+  EXPECT_NO_THROW(single.configure(fake_config("cam7")));
+  EXPECT_EQ(single.triggers_per_set(), 2);
+}
+
+}  // namespace
+}  // namespace tomorig::acquisition
