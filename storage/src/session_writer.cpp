@@ -19,6 +19,7 @@
 #include "h5_datasets.h"
 #include "h5_error.h"
 #include "h5_handle.h"
+#include "output_lock.h"
 #include "output_path.h"
 #include "partial_file.h"
 #include "session_layout.h"
@@ -52,6 +53,20 @@ void check_cameras(const std::vector<SessionCamera>& cameras, const fs::path& fi
   }
 }
 
+
+// A "<path>.partial" that exists before this writer starts was left by a writer that never
+// finished: a live recording keeps every set it flushed there. It is evidence, never replaced.
+[[noreturn]] void refuse_left_over_partial(const fs::path& partial, const fs::path& final_path) {
+  const std::string p = partial.string();
+  const fs::path kept = fs::path(final_path).replace_extension("").concat("-recovered").concat(
+      final_path.extension().string());
+  throw bad_input(fmt::format(
+      "'{}' already exists: an earlier recording into '{}' did not finish (it was killed, crashed or lost power) and "
+      "may hold recorded sets, so tomorig never replaces it, not even with --overwrite. See what it holds: "
+      "tomorig inspect '{}'. To keep it: mv '{}' '{}' (other HDF5 tools may then need: h5clear -s '{}'). To "
+      "discard it: rm '{}'. Then run again.",
+      p, final_path.string(), p, p, kept.string(), kept.string(), p));
+}
 
 std::string describe_image(const Image& image) {
   return fmt::format("{} x {} {}", image.width(), image.height(), to_string(image.type()));
@@ -95,7 +110,9 @@ struct SessionWriter::Impl {
   void complete_live_file();
 
   // Declaration order matters: members are destroyed in reverse, so every dataset is closed,
-  // then the file, and only then does `partial` delete the file if it was not finished.
+  // then the file, then `partial` deletes the file if it was not finished, and only then is
+  // the name unlocked for another writer.
+  OutputLock lock;
   PartialFile partial;
   fs::path final_path;
   SessionWriterOptions options;
@@ -127,6 +144,9 @@ SessionWriter::Impl::Impl(const fs::path& path, const SessionInfo& info, const S
     : partial(fs::path(path).concat(".partial")), final_path(path), options(opts) {
   check_cameras(info.cameras, final_path);
   check_output_path(final_path, options.overwrite, "session");
+  lock = OutputLock::acquire(final_path, "session");
+  std::error_code ec;
+  if (fs::exists(fs::symlink_status(partial.path(), ec))) refuse_left_over_partial(partial.path(), final_path);
   if (options.compression != Compression::none)
     require_filter(kBitshuffleFilterId, fmt::format("writing session '{}' with {} compression", final_path.string(),
                                                     to_string(options.compression)));
@@ -139,7 +159,8 @@ SessionWriter::Impl::Impl(const fs::path& path, const SessionInfo& info, const S
   if (options.live)
     h5::check(H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_LATEST, H5F_LIBVER_LATEST), "cannot configure",
               "a file access list");
-  const hid_t id = H5Fcreate(partial.path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get());
+  // EXCL: even if something created the partial file since the check above, it is not truncated.
+  const hid_t id = H5Fcreate(partial.path().c_str(), H5F_ACC_EXCL, H5P_DEFAULT, fapl.get());
   if (id < 0)
     throw bad_input(fmt::format("cannot create session file '{}' (is folder '{}' writable?): {}",
                                 partial.path().string(), partial.path().parent_path().string(),
@@ -534,6 +555,7 @@ void SessionWriter::finish() {
   }
   m.partial.release();
   m.finished = true;
+  m.lock = OutputLock();  // the file is complete under its name: another writer may now replace it
 }
 
 std::uint64_t SessionWriter::sets_written() const { return impl_->sets; }
