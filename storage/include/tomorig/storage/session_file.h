@@ -151,8 +151,12 @@ class SessionWriter {
 
 class SessionReader {
  public:
-  // Opens and validates the layout. Throws tomorig::Error (bad_input) naming the file and
-  // what is wrong: missing, not HDF5, not a tomorig session, wrong sizes, truncated datasets.
+  // Opens and validates the layout, types and declared sizes before reading anything (see
+  // "Reading safely" in docs/file-formats.md). Throws tomorig::Error (bad_input) naming the
+  // file and what is wrong: missing, not HDF5, not a tomorig session, wrong sizes or types,
+  // truncated datasets, damaged. The open pass runs first in a forked child process, so a
+  // libhdf5 crash or endless loop on a damaged file ends the child, not the caller: open
+  // readers before starting threads that use HDF5 (a child may inherit a lock they hold).
   explicit SessionReader(const std::filesystem::path& path);
   ~SessionReader();
   SessionReader(const SessionReader&) = delete;
