@@ -4,7 +4,10 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <atomic>
+#include <condition_variable>
+#include <deque>
 #include <mutex>
 #include <thread>
 
@@ -12,6 +15,7 @@
 #include "genicam_features.h"
 #include "glib_handles.h"
 #include "tomorig/acquisition/frame_id.h"
+#include "tomorig/acquisition/trigger_matcher.h"
 #include "tomorig/core/error.h"
 
 namespace tomorig::acquisition {
@@ -20,7 +24,7 @@ namespace {
 using detail::GErrorSlot;
 using detail::GObjectPtr;
 
-constexpr guint64 kPopTimeoutUs = 100'000;  // how often the delivery thread checks for stop()
+constexpr guint64 kPopTimeoutUs = 50'000;  // how often the delivery thread checks for stop() and lost frames
 
 // Sample type of the pixel formats tomorig stores; nullopt for packed or colour formats.
 std::optional<SampleType> sample_type_of_arv(ArvPixelFormat format) {
@@ -48,11 +52,47 @@ std::vector<std::string> list_aravis_devices() {
   return devices;
 }
 
+namespace {
+
+std::int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+int frames_per_trigger(config::FrameMode mode) { return mode == config::FrameMode::hardware ? 2 : 1; }
+
+}  // namespace
+
 struct AravisCamera::Impl {
   std::string id;
   AravisCameraOptions options;
   config::CameraConfig config;
   GObjectPtr<ArvCamera> camera;
+  gulong control_lost_handler = 0;
+
+  // Connection watch: every trigger the camera took is remembered until the first packet of
+  // its frame arrives; one left unanswered for options.frame_timeout means the camera is gone.
+  mutable std::mutex watch_mutex;
+  std::deque<std::int64_t> unanswered_triggers;  // steady-clock times, oldest first
+  std::uint64_t triggers_taken = 0;
+  std::uint64_t triggers_answered = 0;
+  std::atomic<bool> disconnected{false};
+  std::string problem;  // guarded by watch_mutex
+
+  // The trigger thread sends queued TriggerSoftware commands, so a dead camera (whose every
+  // command waits for GVCP timeouts) never holds up the rig loop or the other cameras.
+  struct TriggerJob {
+    std::optional<std::uint64_t> event;  // nullopt: warm-up, one trigger, its frames discarded
+    std::int64_t spacing_ns = 0;         // two_triggers: frame B's trigger after frame A's
+  };
+  std::mutex trigger_mutex;
+  std::condition_variable trigger_wanted;
+  std::deque<TriggerJob> trigger_jobs;
+  std::thread trigger_thread;
+  // Software triggers: which trigger each frame answers, by time (null: frames are counted).
+  std::unique_ptr<TriggerMatcher> matcher;
+  std::atomic<std::uint64_t> unmatched{0};
+
   std::shared_ptr<detail::AravisBufferPool> pool;  // kept after stop() so statistics stay readable
   mutable std::mutex pool_mutex;  // guards the `pool` pointer for statistics() (sinks may call it)
   std::size_t payload = 0;
@@ -67,9 +107,105 @@ struct AravisCamera::Impl {
 
   void open(const std::string& device_id);
   void apply(const config::CameraConfig& cfg);
+  void apply_frame_mode(ArvDevice* device, const config::CameraConfig& cfg);
   void deliver_loop();
   void deliver(ArvBuffer* buffer, FrameIdUnwrapper& unwrapper);
+  void trigger_loop();
+  bool send_trigger();  // false: the command failed and the camera is marked disconnected
+  void trigger_taken();
+  void frames_seen(std::uint64_t sequence);
+  void check_unanswered();
+  void mark_disconnected(std::string why);
+  void forget_camera();
+  static void on_control_lost(ArvDevice*, gpointer data);
 };
+
+void AravisCamera::Impl::mark_disconnected(std::string why) {
+  std::lock_guard lock(watch_mutex);
+  if (disconnected) return;
+  problem = std::move(why);
+  disconnected = true;
+}
+
+void AravisCamera::Impl::trigger_taken() {
+  std::lock_guard lock(watch_mutex);
+  ++triggers_taken;
+  unanswered_triggers.push_back(steady_ns());
+}
+
+// Frame `sequence` (0-based since start) began to arrive: the triggers up to it are answered.
+void AravisCamera::Impl::frames_seen(std::uint64_t sequence) {
+  const std::uint64_t per_trigger = static_cast<std::uint64_t>(frames_per_trigger(options.frame_mode));
+  const std::uint64_t answered = sequence / per_trigger + 1;
+  std::lock_guard lock(watch_mutex);
+  while (triggers_answered < answered && !unanswered_triggers.empty()) {
+    unanswered_triggers.pop_front();
+    ++triggers_answered;
+  }
+}
+
+void AravisCamera::Impl::check_unanswered() {
+  std::int64_t oldest = 0;
+  {
+    std::lock_guard lock(watch_mutex);
+    if (unanswered_triggers.empty() || disconnected) return;
+    oldest = unanswered_triggers.front();
+  }
+  const std::int64_t waited = steady_ns() - oldest;
+  if (waited > std::chrono::nanoseconds(options.frame_timeout).count())
+    mark_disconnected(fmt::format("no frame {} ms after a trigger it took (frame timeout {} ms): the camera, its cable "
+                                  "or its stream is gone",
+                                  waited / 1'000'000, options.frame_timeout.count()));
+}
+
+// The trigger counts from when it was asked for: a camera that died stops answering the
+// command itself, and the watch must not wait for the command's own timeouts.
+bool AravisCamera::Impl::send_trigger() {
+  GErrorSlot error;
+  arv_camera_software_trigger(camera.get(), error.out());
+  if (error) {
+    mark_disconnected(fmt::format("TriggerSoftware failed: {}", error.message()));
+    return false;
+  }
+  return true;
+}
+
+// One job per trigger event: frame A's trigger, and for two_triggers frame B's, spaced from
+// when A's was really sent (not when it was asked for), so a busy host delays both alike.
+void AravisCamera::Impl::trigger_loop() {
+  for (;;) {
+    TriggerJob job;
+    {
+      std::unique_lock lock(trigger_mutex);
+      trigger_wanted.wait(lock, [&] { return !trigger_jobs.empty() || !running; });
+      if (!running) return;
+      job = trigger_jobs.front();
+      trigger_jobs.pop_front();
+    }
+    const int triggers = job.event && options.frame_mode == config::FrameMode::two_triggers ? 2 : 1;
+    std::int64_t frame_a_sent = 0;
+    for (int k = 0; k < triggers && !disconnected && running; ++k) {
+      if (k == 1)
+        std::this_thread::sleep_until(std::chrono::steady_clock::time_point(std::chrono::nanoseconds(frame_a_sent + job.spacing_ns)));
+      const std::int64_t now = steady_ns();
+      if (k == 0) frame_a_sent = now;
+      if (matcher) matcher->expect({job.event, k == 0 ? Exposure::A : Exposure::B, now});
+      trigger_taken();
+      send_trigger();
+    }
+  }
+}
+
+void AravisCamera::Impl::on_control_lost(ArvDevice*, gpointer data) {
+  static_cast<Impl*>(data)->mark_disconnected("Aravis reported control-lost (heartbeat unanswered)");
+}
+
+void AravisCamera::Impl::forget_camera() {
+  if (camera && control_lost_handler != 0)
+    g_signal_handler_disconnect(arv_camera_get_device(camera.get()), control_lost_handler);
+  control_lost_handler = 0;
+  camera.reset();
+}
 
 void AravisCamera::Impl::open(const std::string& device_id) {
   GErrorSlot error;
@@ -83,6 +219,8 @@ void AravisCamera::Impl::open(const std::string& device_id) {
         found.empty() ? std::string("none") : fmt::format("{}", fmt::join(found, ", "))));
   }
   camera.reset(opened);
+  control_lost_handler =
+      g_signal_connect(arv_camera_get_device(camera.get()), "control-lost", G_CALLBACK(on_control_lost), this);
 }
 
 void AravisCamera::Impl::apply(const config::CameraConfig& cfg) {
@@ -100,12 +238,7 @@ void AravisCamera::Impl::apply(const config::CameraConfig& cfg) {
       detail::set_feature(device, id, "OffsetY", std::to_string(cfg.roi.offset_y));
   }
   if (!options.acquisition_mode.empty()) detail::set_feature(device, id, "AcquisitionMode", options.acquisition_mode);
-  if (!options.trigger_mode.empty()) {
-    if (detail::has_feature(device, "TriggerSelector")) detail::set_feature(device, id, "TriggerSelector", "FrameStart");
-    detail::set_feature(device, id, "TriggerMode", options.trigger_mode);
-    if (options.trigger_mode == "On" && !options.trigger_source.empty())
-      detail::set_feature(device, id, "TriggerSource", options.trigger_source);
-  }
+  apply_frame_mode(device, cfg);
   if (options.exposure_time_us) {
     const char* name = detail::has_feature(device, "ExposureTime") ? "ExposureTime" : "ExposureTimeAbs";
     detail::set_feature(device, id, name, fmt::format("{}", *options.exposure_time_us));
@@ -124,6 +257,51 @@ void AravisCamera::Impl::apply(const config::CameraConfig& cfg) {
     throw runtime_error(fmt::format("camera {}: cannot read the payload size: {}", id, error.message()));
 }
 
+// The frame mode as GenICam (SFNC) features. A double-frame ("hardware") camera answers one
+// trigger with two frames: SFNC says FrameBurstStart with a burst of 2. A camera offering
+// neither is taken for a single-frame camera and refused, unless the rig file sets
+// TriggerSelector itself (a vendor double-shutter mode, configured in [cameras.features]).
+void AravisCamera::Impl::apply_frame_mode(ArvDevice* device, const config::CameraConfig& cfg) {
+  const bool selector = detail::has_feature(device, "TriggerSelector");
+  auto select = [&](const std::string& what) {
+    if (selector) detail::set_feature(device, id, "TriggerSelector", what);
+  };
+  if (options.frame_mode == config::FrameMode::free_run) {
+    select("FrameStart");
+    detail::set_feature(device, id, "TriggerMode", "Off");
+    return;
+  }
+  if (options.frame_mode == config::FrameMode::hardware) {
+    const auto selectors = detail::enumeration_entries(device, "TriggerSelector");
+    const bool burst = std::find(selectors.begin(), selectors.end(), "FrameBurstStart") != selectors.end() &&
+                       detail::has_feature(device, "AcquisitionBurstFrameCount");
+    if (burst) {
+      select("FrameStart");  // only the burst trigger starts frames
+      detail::set_feature(device, id, "TriggerMode", "Off");
+      select("FrameBurstStart");
+      detail::set_feature(device, id, "AcquisitionBurstFrameCount", "2");
+    } else if (!cfg.features.count("TriggerSelector")) {
+      throw bad_input(fmt::format(
+          "camera {}: frame_mode = \"hardware\" needs a camera that takes two frames per trigger, but GenICam feature "
+          "TriggerSelector offers no FrameBurstStart (it offers: {}) and there is no AcquisitionBurstFrameCount: this "
+          "is a single-frame camera. Set frame_mode = \"two_triggers\" (with [trigger.camera] readout_us), or, for a "
+          "double-shutter camera with a vendor mode, set that mode and TriggerSelector in [cameras.features]",
+          id, selectors.empty() ? std::string("nothing") : fmt::format("{}", fmt::join(selectors, ", "))));
+    } else {
+      select("FrameStart");  // [cameras.features] chooses the selector and the vendor mode after this
+    }
+  } else {
+    select("FrameStart");
+  }
+  detail::set_feature(device, id, "TriggerMode", "On");
+  detail::set_feature(device, id, "TriggerSource", options.trigger_source);
+  // The plan's edges rise; a software trigger has no edge, and some cameras lock the feature then.
+  if (options.trigger_source != "Software" && !options.trigger_activation.empty())
+    detail::set_feature(device, id, "TriggerActivation", options.trigger_activation);
+  else if (!options.trigger_activation.empty() && detail::feature_available(device, "TriggerActivation"))
+    detail::set_feature(device, id, "TriggerActivation", options.trigger_activation);
+}
+
 void AravisCamera::Impl::deliver(ArvBuffer* buffer, FrameIdUnwrapper& unwrapper) {
   const guint64 raw_id = arv_buffer_get_frame_id(buffer);
   if (raw_id == 0 && options.frame_id_zero_reserved) {  // failed before any packet said which frame
@@ -132,6 +310,7 @@ void AravisCamera::Impl::deliver(ArvBuffer* buffer, FrameIdUnwrapper& unwrapper)
   }
   const auto sequence = unwrapper.unwrap(raw_id);
   frame_id_gaps = unwrapper.gaps();
+  if (sequence) frames_seen(*sequence);  // failed or not, the camera answered its trigger
   // Incomplete or corrupt buffers still move the frame-id sequence (so later frames keep
   // their A/B role) but are never delivered: Aravis counts them as failures.
   if (!sequence) {  // stale or duplicate id: not a frame of this acquisition's sequence
@@ -162,6 +341,17 @@ void AravisCamera::Impl::deliver(ArvBuffer* buffer, FrameIdUnwrapper& unwrapper)
   frame.trigger_index = *sequence / 2;
   frame.exposure = *sequence % 2 == 0 ? Exposure::A : Exposure::B;
   frame.timestamp_ns = static_cast<std::int64_t>(arv_buffer_get_timestamp(buffer));
+  if (matcher) {
+    // The camera numbers frames, not events: the trigger it answers is found by time.
+    const auto hit = matcher->match(*sequence, frame.timestamp_ns);
+    if (!hit || !hit->event) {  // a warm-up frame, or one no trigger explains
+      if (!hit) ++unmatched;
+      pool->give_back(buffer);
+      return;
+    }
+    frame.trigger_index = *hit->event;
+    frame.exposure = hit->exposure;
+  }
   frame.image = Image::view(const_cast<void*>(data), width, height, *type, 0, pool->lease(buffer));
   ++delivered;
   sink(std::move(frame));
@@ -173,6 +363,7 @@ void AravisCamera::Impl::deliver_loop() {
   while (running) {
     ArvBuffer* buffer = arv_stream_timeout_pop_buffer(pool->stream(), kPopTimeoutUs);
     if (buffer != nullptr) deliver(buffer, unwrapper);
+    check_unanswered();
   }
 }
 
@@ -187,11 +378,21 @@ AravisCamera::AravisCamera(std::string id, AravisCameraOptions options) : impl_(
   FrameIdUnwrapper check(impl_->options.frame_id_bits, impl_->options.frame_id_zero_reserved);  // validates
 }
 
-AravisCamera::~AravisCamera() { stop(); }
+AravisCamera::~AravisCamera() {
+  stop();
+  impl_->forget_camera();
+}
 
 const std::string& AravisCamera::id() const { return impl_->id; }
 
-int AravisCamera::triggers_per_set() const { return impl_->options.mode == DoubleFrameMode::double_frame ? 1 : 2; }
+int AravisCamera::triggers_per_set() const {
+  switch (impl_->options.frame_mode) {
+    case config::FrameMode::hardware: return 1;
+    case config::FrameMode::two_triggers: return 2;
+    case config::FrameMode::free_run: return 0;
+  }
+  return 1;
+}
 
 void AravisCamera::configure(const config::CameraConfig& config) {
   std::lock_guard lock(impl_->mutex);
@@ -202,7 +403,7 @@ void AravisCamera::configure(const config::CameraConfig& config) {
   if (config.device_id.empty())
     throw bad_input(fmt::format("camera {}: device_id is empty: give the Aravis device id or IP address", impl_->id));
   if (!impl_->camera || config.device_id != impl_->config.device_id) {
-    impl_->camera.reset();
+    impl_->forget_camera();
     impl_->open(config.device_id);
   }
   impl_->config = config;
@@ -236,12 +437,28 @@ void AravisCamera::start(FrameSink sink) {
   impl_->delivered = 0;
   impl_->frame_id_gaps = 0;
   impl_->rejected = 0;
+  {
+    std::lock_guard watch(impl_->watch_mutex);
+    impl_->unanswered_triggers.clear();
+    impl_->triggers_taken = impl_->triggers_answered = 0;
+  }
+  impl_->trigger_jobs.clear();
+  impl_->unmatched = 0;
+  if (impl_->options.trigger_source == "Software" && impl_->options.match_tolerance_ns > 0 &&
+      impl_->options.frame_mode != config::FrameMode::free_run)
+    impl_->matcher = std::make_unique<TriggerMatcher>(frames_per_trigger(impl_->options.frame_mode),
+                                                      impl_->options.match_tolerance_ns);
+  else
+    impl_->matcher.reset();
   impl_->running = true;
   impl_->delivery = std::thread([impl = impl_.get()] { impl->deliver_loop(); });
+  impl_->trigger_thread = std::thread([impl = impl_.get()] { impl->trigger_loop(); });
   arv_camera_start_acquisition(impl_->camera.get(), error.out());
   if (error) {
     impl_->running = false;
+    impl_->trigger_wanted.notify_all();
     impl_->delivery.join();
+    impl_->trigger_thread.join();
     throw runtime_error(fmt::format("camera {}: AcquisitionStart failed: {}", impl_->id, error.message()));
   }
 }
@@ -249,18 +466,45 @@ void AravisCamera::start(FrameSink sink) {
 void AravisCamera::stop() {
   std::lock_guard lock(impl_->mutex);
   if (!impl_->running) return;
-  impl_->running = false;
+  {
+    std::lock_guard trigger_lock(impl_->trigger_mutex);
+    impl_->running = false;
+  }
+  impl_->trigger_wanted.notify_all();
   if (impl_->delivery.joinable()) impl_->delivery.join();
+  if (impl_->trigger_thread.joinable()) impl_->trigger_thread.join();
+  // A camera known to be gone would make AcquisitionStop wait out every GVCP retry.
   GErrorSlot error;
-  if (impl_->camera) arv_camera_stop_acquisition(impl_->camera.get(), error.out());  // a vanished camera: nothing to stop
+  if (impl_->camera && !impl_->disconnected) arv_camera_stop_acquisition(impl_->camera.get(), error.out());
   impl_->sink = nullptr;
 }
 
 void AravisCamera::software_trigger() {
   if (!impl_->camera) throw runtime_error(fmt::format("camera {}: software trigger before configure()", impl_->id));
-  GErrorSlot error;
-  arv_camera_software_trigger(impl_->camera.get(), error.out());
-  if (error) throw runtime_error(fmt::format("camera {}: TriggerSoftware failed: {}", impl_->id, error.message()));
+  impl_->trigger_taken();
+  if (!impl_->send_trigger())
+    throw runtime_error(fmt::format("camera {}: {}", impl_->id, connection_problem()));
+}
+
+void AravisCamera::request_software_trigger(std::optional<std::uint64_t> event, std::int64_t spacing_ns) {
+  if (!impl_->running) throw runtime_error(fmt::format("camera {}: software trigger requested before start()", impl_->id));
+  if (impl_->disconnected) return;
+  {
+    std::lock_guard lock(impl_->trigger_mutex);
+    impl_->trigger_jobs.push_back({event, spacing_ns});
+  }
+  impl_->trigger_wanted.notify_one();
+}
+
+std::uint64_t AravisCamera::frames_unmatched() const { return impl_->unmatched; }
+
+void AravisCamera::note_hardware_trigger() { impl_->trigger_taken(); }
+
+bool AravisCamera::connected() const { return !impl_->disconnected; }
+
+std::string AravisCamera::connection_problem() const {
+  std::lock_guard lock(impl_->watch_mutex);
+  return impl_->problem;
 }
 
 StreamStatistics AravisCamera::statistics() const {

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <cstdlib>
 #include <set>
 #include <utility>
 
@@ -28,6 +29,17 @@ void AssemblerOptions::validate() const {
     throw bad_input(fmt::format("assembler timeout = {} ns: must be > 0", timeout.count()));
   if (max_index_jump == 0) throw bad_input("assembler max_index_jump = 0: must be > 0");
   if (max_queued_sets == 0) throw bad_input("assembler max_queued_sets = 0: must be > 0");
+  if (!pairing.empty() && pairing.size() != camera_ids.size())
+    throw bad_input(fmt::format("assembler pairing lists {} cameras but camera_ids {}: give one entry per camera or none",
+                                pairing.size(), camera_ids.size()));
+  for (std::size_t c = 0; c < pairing.size(); ++c)
+    if (pairing[c].tolerance_ns < 0)
+      throw bad_input(fmt::format("assembler pairing of {}: tolerance {} ns must be >= 0", camera_ids[c],
+                                  pairing[c].tolerance_ns));
+}
+
+const AssemblerOptions::CameraPairing* FrameSetAssembler::pairing_of(std::size_t camera) const {
+  return camera < options_.pairing.size() ? &options_.pairing[camera] : nullptr;
 }
 
 FrameSetAssembler::FrameSetAssembler(AssemblerOptions options, AssemblyClock clock)
@@ -41,6 +53,79 @@ bool FrameSetAssembler::accept_index_locked(std::uint64_t index) {
   if (!next_index_) next_index_ = index;
   if (index < *next_index_) return false;  // its set has been emitted already
   return true;
+}
+
+bool FrameSetAssembler::ready_locked(const Pending& p) const {
+  for (std::size_t c = 0; c < p.set.cameras.size(); ++c) {
+    if (stats_.cameras[c].lost) continue;  // nothing more will come from it
+    if (!p.set.cameras[c].a.present() || !p.set.cameras[c].b.present()) return false;
+  }
+  return true;
+}
+
+void FrameSetAssembler::place_locked(std::size_t camera, Pending& p, CameraFrame&& frame) {
+  CameraLoss& loss = stats_.cameras[camera];
+  Frame& slot = p.set.cameras[camera][frame.exposure];
+  if (slot.present()) {
+    ++loss.frames_duplicate;
+    return;
+  }
+  ++loss.frames_received;
+  slot.image = std::move(frame.image);
+  slot.timestamp_ns = frame.timestamp_ns;
+  const auto* pairing = pairing_of(camera);
+  slot.synchronised = pairing == nullptr || !pairing->free_running;
+  if (!p.trigger_known && !p.frame_timing_known && frame.trigger_timestamp_ns != 0) {
+    p.set.trigger_timestamp_ns = frame.trigger_timestamp_ns;
+    p.set.dt_ns = frame.dt_ns;
+    p.frame_timing_known = true;
+  }
+}
+
+void FrameSetAssembler::place_free_running_locked(std::size_t camera, CameraFrame&& frame) {
+  const std::int64_t arrived = clock_();
+  for (auto& [index, p] : pending_) {
+    if (!p.trigger_known || p.announced_ns > arrived) continue;  // the event had not happened yet
+    CameraFrames& slots = p.set.cameras[camera];
+    if (slots.a.present() && slots.b.present()) continue;
+    frame.trigger_index = index;
+    frame.exposure = slots.a.present() ? Exposure::B : Exposure::A;
+    place_locked(camera, p, std::move(frame));
+    return;
+  }
+  ++stats_.cameras[camera].frames_surplus;
+}
+
+// Frames A and B of one camera belong to one trigger event only if their timestamps are as
+// far apart as the plan puts the two frames. Anything else (B − A a whole period, or negative)
+// means the camera skipped or added a frame and the pair straddles two events: both go.
+void FrameSetAssembler::check_pairs_locked(FrameSet& set) {
+  for (std::size_t c = 0; c < set.cameras.size(); ++c) {
+    const auto* pairing = pairing_of(c);
+    if (pairing == nullptr || pairing->tolerance_ns <= 0 || pairing->free_running) continue;
+    CameraFrames& frames = set.cameras[c];
+    if (!frames.a.present() || !frames.b.present() || frames.a.timestamp_ns == 0 || frames.b.timestamp_ns == 0)
+      continue;
+    const std::int64_t separation = frames.b.timestamp_ns - frames.a.timestamp_ns;
+    if (std::llabs(separation - pairing->expected_separation_ns) <= pairing->tolerance_ns) continue;
+    CameraLoss& loss = stats_.cameras[c];
+    loss.frames_mismatched += 2;
+    loss.frames_received -= 2;  // counted again as missing below: the set never holds them
+    loss.last_mismatch = fmt::format(
+        "set of trigger {}: frames A and B of {} are {:.3f} ms apart by the camera's clock, the plan says {:.3f} ms "
+        "± {:.3f} ms, so they came from different trigger events; both dropped, the set is incomplete",
+        set.trigger_index, loss.camera_id, static_cast<double>(separation) / 1e6,
+        static_cast<double>(pairing->expected_separation_ns) / 1e6, static_cast<double>(pairing->tolerance_ns) / 1e6);
+    frames.a = Frame{};
+    frames.b = Frame{};
+  }
+}
+
+void FrameSetAssembler::mark_camera_lost(std::size_t camera) {
+  std::unique_lock lock(mutex_);
+  if (camera >= stats_.cameras.size()) return;
+  stats_.cameras[camera].lost = true;
+  expire_locked(lock, clock_());
 }
 
 FrameSetAssembler::Pending& FrameSetAssembler::pending_for_locked(std::uint64_t index, std::int64_t now) {
@@ -74,6 +159,17 @@ void FrameSetAssembler::add_frame(std::size_t camera, CameraFrame frame) {
     return;
   }
   CameraLoss& loss = stats_.cameras[camera];
+  const auto* pairing = pairing_of(camera);
+  if (pairing != nullptr && pairing->free_running) {
+    place_free_running_locked(camera, std::move(frame));
+    expire_locked(lock, now);
+    return;
+  }
+  if (options_.end_trigger_index && frame.trigger_index >= *options_.end_trigger_index) {
+    ++loss.frames_beyond_run;
+    expire_locked(lock, now);
+    return;
+  }
   if (!accept_index_locked(frame.trigger_index)) {
     ++loss.frames_late;
     expire_locked(lock, now);
@@ -85,33 +181,22 @@ void FrameSetAssembler::add_frame(std::size_t camera, CameraFrame frame) {
     expire_locked(lock, now);
     return;
   }
-  Pending& p = pending_for_locked(frame.trigger_index, now);
-  Frame& slot = p.set.cameras[camera][frame.exposure];
-  if (slot.present()) {
-    ++loss.frames_duplicate;
-  } else {
-    ++loss.frames_received;
-    slot.image = std::move(frame.image);
-    slot.timestamp_ns = frame.timestamp_ns;
-    if (!p.trigger_known && !p.frame_timing_known && frame.trigger_timestamp_ns != 0) {
-      p.set.trigger_timestamp_ns = frame.trigger_timestamp_ns;
-      p.set.dt_ns = frame.dt_ns;
-      p.frame_timing_known = true;
-    }
-  }
+  place_locked(camera, pending_for_locked(frame.trigger_index, now), std::move(frame));
   expire_locked(lock, now);
 }
 
 void FrameSetAssembler::add_trigger(const TriggerInput& trigger) {
   std::unique_lock lock(mutex_);
   const std::int64_t now = clock_();
-  if (accept_index_locked(trigger.index)) {
+  const bool in_run = !options_.end_trigger_index || trigger.index < *options_.end_trigger_index;
+  if (in_run && accept_index_locked(trigger.index)) {
     const std::uint64_t horizon = pending_.empty() ? *next_index_ : pending_.begin()->first;
     if (trigger.index - horizon <= options_.max_index_jump) {
       Pending& p = pending_for_locked(trigger.index, now);
       p.set.trigger_timestamp_ns = trigger.timestamp_ns;
       p.set.dt_ns = trigger.dt_ns;
       p.trigger_known = true;
+      p.announced_ns = now;
     }
   }
   expire_locked(lock, now);
@@ -124,16 +209,9 @@ void FrameSetAssembler::emit_front_locked(std::unique_lock<std::mutex>&) {
   next_index_ = p.set.trigger_index + 1;
 
   FrameSet& set = p.set;
-  if (!p.trigger_known && !p.frame_timing_known) {
-    // No trigger clock for this set: fall back on the camera clock of the first camera
-    // that delivered frame A (and B for Δt).
-    for (const auto& c : set.cameras) {
-      if (!c.a.present()) continue;
-      set.trigger_timestamp_ns = c.a.timestamp_ns;
-      if (c.b.present()) set.dt_ns = c.b.timestamp_ns - c.a.timestamp_ns;
-      break;
-    }
-  }
+  // Without a trigger the set's time stays 0 (unknown): trigger_timestamp_ns is on the
+  // trigger clock in every set, never a camera's clock.
+  check_pairs_locked(set);
   set.set_index = next_set_index_++;
   for (std::size_t c = 0; c < set.cameras.size(); ++c)
     stats_.cameras[c].frames_missing += (set.cameras[c].a.present() ? 0 : 1) + (set.cameras[c].b.present() ? 0 : 1);
@@ -147,7 +225,7 @@ void FrameSetAssembler::emit_front_locked(std::unique_lock<std::mutex>&) {
 void FrameSetAssembler::expire_locked(std::unique_lock<std::mutex>& lock, std::int64_t now) {
   while (!pending_.empty()) {
     const Pending& front = pending_.begin()->second;
-    if (!front.set.complete() && front.deadline_ns > now) break;
+    if (!ready_locked(front) && front.deadline_ns > now) break;
     emit_front_locked(lock);
   }
 }
@@ -197,6 +275,11 @@ std::optional<FrameSet> FrameSetAssembler::pop(std::chrono::milliseconds wait) {
 std::size_t FrameSetAssembler::queued() const {
   std::lock_guard lock(mutex_);
   return queue_.size();
+}
+
+std::size_t FrameSetAssembler::pending() const {
+  std::lock_guard lock(mutex_);
+  return pending_.size();
 }
 
 AssemblyStatistics FrameSetAssembler::statistics() const {

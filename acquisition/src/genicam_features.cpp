@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 
 #include "glib_handles.h"
 #include "tomorig/core/error.h"
@@ -24,6 +25,13 @@ ArvGcFeatureNode* find_feature(ArvDevice* device, const std::string& feature) {
 }  // namespace
 
 bool has_feature(ArvDevice* device, const std::string& feature) { return find_feature(device, feature) != nullptr; }
+
+bool feature_available(ArvDevice* device, const std::string& feature) {
+  ArvGcFeatureNode* node = find_feature(device, feature);
+  if (node == nullptr) return false;
+  GErrorSlot error;
+  return arv_gc_feature_node_is_available(node, error.out()) && !error;
+}
 
 std::vector<std::string> enumeration_entries(ArvDevice* device, const std::string& feature) {
   std::vector<std::string> entries;
@@ -70,11 +78,38 @@ void set_feature(ArvDevice* device, const std::string& camera_id, const std::str
       throw bad_input(fmt::format("camera {}: GenICam feature {} = {} is out of range: the camera allows {} to {}",
                                   camera_id, feature, wanted, lo, hi));
   }
+  // A float outside the camera's range is refused here too, naming the range.
+  double wanted_float = 0.0;
+  const auto parsed_float = std::from_chars(value.data(), value.data() + value.size(), wanted_float);
+  const bool float_value = parsed_float.ec == std::errc() && parsed_float.ptr == value.data() + value.size();
+  if (ARV_IS_GC_FLOAT(node) && float_value) {
+    GErrorSlot range_error;
+    const double lo = arv_gc_float_get_min(ARV_GC_FLOAT(node), range_error.out());
+    const double hi = range_error ? wanted_float : arv_gc_float_get_max(ARV_GC_FLOAT(node), range_error.out());
+    if (!range_error && (wanted_float < lo || wanted_float > hi))
+      throw bad_input(fmt::format("camera {}: GenICam feature {} = {} is out of range: the camera allows {} to {}",
+                                  camera_id, feature, value, lo, hi));
+  }
   arv_gc_feature_node_set_value_from_string(node, value.c_str(), error.out());
   if (error)
     throw bad_input(fmt::format("camera {}: setting GenICam feature {} = '{}' failed: {}", camera_id, feature, value,
                                 error.message()));
 
+  // Read back: an entry or a number the camera silently replaced would leave it running on
+  // something other than the plan.
+  if (ARV_IS_GC_ENUMERATION(node)) {
+    const char* got = arv_gc_enumeration_get_string_value(ARV_GC_ENUMERATION(node), error.out());
+    if (!error && (got == nullptr || value != got))
+      throw bad_input(fmt::format("camera {}: GenICam feature {} = '{}' was not accepted (the camera reads back '{}')",
+                                  camera_id, feature, value, got != nullptr ? got : ""));
+  }
+  if (ARV_IS_GC_FLOAT(node) && float_value) {
+    const double got = arv_gc_float_get_value(ARV_GC_FLOAT(node), error.out());
+    // Cameras keep floats in their own units and steps; a thousandth is rounding, more is not.
+    if (!error && std::abs(got - wanted_float) > 1e-3 * std::max(1.0, std::abs(wanted_float)))
+      throw bad_input(fmt::format("camera {}: GenICam feature {} = {} was not accepted (the camera reads back {})",
+                                  camera_id, feature, value, got));
+  }
   // An integer the camera silently rounds or clamps (Width = 5000 on a 2048-pixel sensor)
   // would change the image size behind the configuration's back: refuse it.
   if (ARV_IS_GC_INTEGER(node)) {

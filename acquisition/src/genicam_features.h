@@ -9,11 +9,13 @@ namespace tomorig::acquisition::detail {
 
 // Whether the camera's GenICam description has an implemented feature of this name.
 bool has_feature(ArvDevice* device, const std::string& feature);
+// ... and whether it can be written in the camera's current state.
+bool feature_available(ArvDevice* device, const std::string& feature);
 
 // Sets `feature` to `value` (an enumeration entry, a number, a boolean or a string).
 // Throws bad_input "camera <camera_id>: ..." naming the feature when the camera lacks it,
-// an enumeration does not offer the value (listing what it offers), or the camera refuses or
-// changes the value.
+// an enumeration does not offer the value (listing what it offers), a number is out of the
+// camera's range, or the camera refuses or changes the value (read back after writing).
 void set_feature(ArvDevice* device, const std::string& camera_id, const std::string& feature,
                  const std::string& value);
 

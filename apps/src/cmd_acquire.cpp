@@ -94,7 +94,7 @@ void acquire(const AcquireOptions& opt) {
   auto refresh = [&](bool final) {
     const RigProgress progress = rig_run.progress();
     figures.queue_depth = progress.queued_sets;
-    figures.dropped_trigger_events = progress.dropped_trigger_events;
+    take_progress(figures, progress);
     status.update(figures, losses, final);
   };
   std::string stopped_by;

@@ -71,6 +71,16 @@ void run(const RunArgs& args) {
   if (report.stopped)
     fmt::print(stderr, "stopped by {} after {} sets; the session is complete\n", stop.signal_name(),
                report.recording.written);
+  // Every set flagged is a run that did not work, whatever was written (a wrong frame_mode,
+  // cameras not answering the trigger): it must not look like success. Free-running cameras
+  // make no set complete by design and are warned about on every status line instead.
+  bool free_running = false;
+  for (const auto& cam : rig.cameras) free_running |= cam.frame_mode == config::FrameMode::free_run;
+  if (report.recording.written > 0 && report.incomplete_sets == report.recording.written && !free_running &&
+      !report.stopped)
+    throw runtime_error(fmt::format("none of the {} sets is complete ({} lost frames); {} keeps them, flagged. Check "
+                                    "the cameras' frame_mode and the messages above",
+                                    report.recording.written, report.frames_lost, out));
 }
 
 }  // namespace

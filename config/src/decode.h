@@ -15,7 +15,8 @@ namespace tomorig::config::detail {
 
 RigConfig decode_rig(const toml::table& root, std::vector<ConfigIssue>& issues);
 
-void decode_cameras(TableReader& root, std::vector<CameraConfig>& cameras);      // [[cameras]]
+// [[cameras]]; after [trigger], whose camera timing frame_mode and features are checked against.
+void decode_cameras(TableReader& root, const TriggerConfig& trigger, std::vector<CameraConfig>& cameras);
 void decode_trigger(TableReader& root, TriggerConfig& trigger);                  // [trigger]
 void decode_grid(TableReader& root, GridConfig& grid);                           // [grid]
 void decode_processing(TableReader& root, ProcessingConfig& processing);         // [processing]

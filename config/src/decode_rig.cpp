@@ -6,8 +6,8 @@ RigConfig decode_rig(const toml::table& root_table, std::vector<ConfigIssue>& is
   RigConfig rig;
   TableReader root(root_table, "", issues);
   root.read("name", rig.name);
-  decode_cameras(root, rig.cameras);
   decode_trigger(root, rig.trigger);
+  decode_cameras(root, rig.trigger, rig.cameras);
   if (auto calibration = root.table("calibration")) {
     std::string file;
     if (calibration->read("file", file, Need::required, not_empty())) rig.calibration_file = file;

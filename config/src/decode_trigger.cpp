@@ -22,6 +22,10 @@ void decode_camera_timing(TableReader& trigger, CameraTimingConfig& camera) {
   r->read("exposure_a_us", camera.exposure_a_us, Need::optional, positive_duration_us());
   r->read("interframe_us", camera.interframe_us, Need::optional, non_negative_time_us());
   r->read("exposure_b_us", camera.exposure_b_us, Need::optional, positive_duration_us());
+  r->read("readout_us", camera.readout_us, Need::optional, positive_duration_us());
+  double tolerance = 0.0;
+  if (r->read("frame_time_tolerance_us", tolerance, Need::optional, positive_duration_us()))
+    camera.frame_time_tolerance_us = tolerance;
   r->report_unknown_keys();
 }
 

@@ -118,4 +118,13 @@ std::string_view to_string(TriggerBackend b) {
   return "unknown";
 }
 
+std::string_view to_string(FrameMode m) {
+  switch (m) {
+    case FrameMode::hardware: return "hardware";
+    case FrameMode::two_triggers: return "two_triggers";
+    case FrameMode::free_run: return "free_run";
+  }
+  return "unknown";
+}
+
 }  // namespace tomorig::config

@@ -1,7 +1,10 @@
 #include "tomorig/rig/rig_acquisition.h"
 
+#include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <exception>
+#include <limits>
 #include <utility>
 
 #include <fmt/core.h>
@@ -20,6 +23,28 @@ using Clock = std::chrono::steady_clock;
 
 // How often the loop looks up from waiting for an event to check for a stop or the duration.
 constexpr std::chrono::milliseconds kEventPoll{50};
+
+// How the assembler checks a camera's pairs: B - A of its timestamps against the plan's frame
+// separation (Aravis cameras; a simulated camera stamps frames with the trigger's own times).
+acquisition::AssemblerOptions::CameraPairing pairing_of(const config::CameraConfig& cam,
+                                                        const config::CameraTimingConfig& timing,
+                                                        const trigger::TimingPlan& plan) {
+  acquisition::AssemblerOptions::CameraPairing pairing;
+  if (cam.frame_mode == config::FrameMode::free_run) {
+    pairing.free_running = true;
+    return pairing;
+  }
+  if (cam.backend != config::CameraBackend::aravis) return pairing;
+  pairing.expected_separation_ns = plan.frame_separation_ns();
+  if (timing.frame_time_tolerance_us) {
+    pairing.tolerance_ns = std::llround(*timing.frame_time_tolerance_us * 1000.0);
+  } else if (cam.frame_mode == config::FrameMode::two_triggers) {
+    // Half the distance to the nearest wrong pairing: B of the next event is a period minus
+    // the separation away, frame A of this one the separation.
+    pairing.tolerance_ns = std::min(pairing.expected_separation_ns, plan.period_ns - pairing.expected_separation_ns) / 2;
+  }
+  return pairing;
+}
 
 }  // namespace
 
@@ -63,18 +88,21 @@ RigAcquisition::RigAcquisition(const config::RigConfig& rig, RigAcquisitionOptio
   }
 
   // The trigger timing and the light sources' safety limits are checked before anything runs;
-  // arm() checks them again on the device's own table.
+  // arm() checks them again on the device's own table, after the cameras took the plan.
   const trigger::RigTrigger rig_trigger = trigger::rig_trigger(rig_);
-  const trigger::TimingPlan plan = trigger::plan_and_check(rig_trigger);
-  device_ = trigger::make_trigger_device(rig_trigger, options_.pacing);
-  device_->arm(plan);
+  plan_ = trigger::plan_and_check(rig_trigger);
 
   acquisition::AssemblerOptions assembly;
   for (const auto& cam : rig_.cameras) assembly.camera_ids.push_back(cam.id);
   assembly.timeout = options_.set_timeout;
+  // Never more sets than asked: frames of trigger indices past the run make none.
+  if (options_.sets) assembly.end_trigger_index = *options_.sets;
+  for (const auto& cam : rig_.cameras) assembly.pairing.push_back(pairing_of(cam, rig_.trigger.camera, plan_));
   assembler_ = std::make_unique<acquisition::FrameSetAssembler>(assembly);
   camera_ids_ = assembly.camera_ids;
   reported_lost_.assign(camera_ids_.size(), false);
+  reported_mismatches_.assign(camera_ids_.size(), 0);
+  for (const auto& cam : rig_.cameras) free_running_.push_back(cam.frame_mode == config::FrameMode::free_run);
 
   if (simulated != 0) {
     if (!rig_.simulation)
@@ -105,14 +133,31 @@ RigAcquisition::RigAcquisition(const config::RigConfig& rig, RigAcquisitionOptio
     // sends software triggers; a hardware trigger device drives the lines itself.
     software_triggers_ = rig_.trigger.backend == config::TriggerBackend::simulated;
     for (const auto& cam : rig_.cameras) {
+      // The camera takes the plan: its frame mode, trigger source and the exposure.
       acquisition::AravisCameraOptions aravis;
+      aravis.frame_mode = cam.frame_mode;
       if (software_triggers_) aravis.trigger_source = "Software";
+      aravis.exposure_time_us = static_cast<double>(plan_.camera.exposure_a_ns) / 1000.0;
+      if (software_triggers_) {
+        // Frames answer triggers a period apart (hardware) or Δt and the rest of the period
+        // apart (two_triggers): half the closer spacing tells them apart.
+        const std::int64_t separation = plan_.frame_separation_ns();
+        const std::int64_t closest = cam.frame_mode == config::FrameMode::two_triggers
+                                         ? std::min(separation, plan_.period_ns - separation)
+                                         : plan_.period_ns;
+        aravis.match_tolerance_ns = closest / 2;
+      }
       auto camera = std::make_unique<acquisition::AravisCamera>(cam.id, aravis);
       camera->configure(cam);  // an absent camera or a refused feature is named here
       session_cameras_.push_back({cam.id, cam.roi.width, cam.roi.height, cam.pixel_format, cam.pixel_pitch_um});
+      aravis_cameras_.push_back(camera.get());
       cameras_.push_back(std::move(camera));
     }
   }
+
+  // Armed last: a camera that cannot meet the plan is refused before any trigger line moves.
+  device_ = trigger::make_trigger_device(rig_trigger, options_.pacing);
+  device_->arm(plan_);
 }
 
 RigAcquisition::~RigAcquisition() {
@@ -126,8 +171,27 @@ RigAcquisition::~RigAcquisition() {
 void RigAcquisition::start() {
   for (std::size_t c = 0; c < cameras_.size(); ++c)
     cameras_[c]->start([this, c](acquisition::CameraFrame&& frame) { assembler_->add_frame(c, std::move(frame)); });
+  warm_up_cameras();
   device_->start(options_.sets);
   worker_ = std::thread([this] { loop(); });
+}
+
+// Some cameras take their first trigger after AcquisitionStart late or not at all (Aravis's
+// GigE fake looks for it only every 100 ms until it has sent a frame, so a second trigger
+// 60 ms later is lost). One trigger before the run, whose frame is discarded, makes every
+// software-triggered camera ready and gives its frame matcher a first frame to measure from.
+void RigAcquisition::warm_up_cameras() {
+  if (!software_triggers_) return;
+  std::vector<std::size_t> warming;
+  for (std::size_t c = 0; c < aravis_cameras_.size(); ++c) {
+    if (free_running_[c]) continue;
+    aravis_cameras_[c]->request_software_trigger(std::nullopt);
+    warming.push_back(c);
+  }
+  const auto give_up = Clock::now() + std::chrono::seconds(1);
+  for (const std::size_t c : warming)
+    while (aravis_cameras_[c]->statistics().delivered == 0 && aravis_cameras_[c]->connected() && Clock::now() < give_up)
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
 }
 
 void RigAcquisition::request_stop() { stop_requested_ = true; }
@@ -142,7 +206,11 @@ void RigAcquisition::loop() {
         break;
       if (options_.sets && events_handled_ + device_->dropped_events() >= *options_.sets) break;
       const auto event = device_->next_event_for(kEventPoll);
-      if (!event) continue;
+      if (!event) {
+        check_cameras(events_handled_);  // a camera lost between events is named within the poll time
+        continue;
+      }
+      announce_dropped_events(event->index);
       handle_event(event->index, event->pulse1_ns, event->dt_ns);
       ++events_handled_;
     }
@@ -151,6 +219,21 @@ void RigAcquisition::loop() {
     failure_ = fmt::format("acquisition failed: {}", e.what());
   }
   finish_run();
+}
+
+// A dropped event fired no camera (software triggers) or fired them unseen (trigger lines):
+// its set still exists, with the event's real time and Δt, and is flagged by what is missing.
+// Announced in index order, just before the next handled event, so a lagging loop does not
+// start the timeouts of sets whose events it has not handled yet.
+void RigAcquisition::announce_dropped_events(std::optional<std::uint64_t> before) {
+  for (auto& e : device_->take_dropped_events()) dropped_.push_back(e);
+  std::size_t announced = 0;
+  for (const auto& e : dropped_) {
+    if (before && e.index > *before) break;
+    assembler_->add_trigger({e.index, e.pulse1_ns, e.dt_ns});
+    ++announced;
+  }
+  dropped_.erase(dropped_.begin(), dropped_.begin() + static_cast<std::ptrdiff_t>(announced));
 }
 
 void RigAcquisition::handle_event(std::uint64_t index, std::int64_t timestamp_ns, std::int64_t dt_ns) {
@@ -170,36 +253,81 @@ void RigAcquisition::handle_event(std::uint64_t index, std::int64_t timestamp_ns
     rendered_.clear();  // frames of a camera that has vanished
   } else {
     assembler_->add_trigger(input);
-    if (software_triggers_)  // otherwise the trigger device's lines fire the cameras
-      for (auto& camera : cameras_) {
-        auto& aravis = static_cast<acquisition::AravisCamera&>(*camera);
-        for (int k = 0; k < aravis.triggers_per_set(); ++k) aravis.software_trigger();
-      }
+    trigger_aravis_cameras(index, dt_ns);
   }
   check_cameras(index);
+  report_mismatches();
+}
+
+// Software triggers follow the plan: every camera is asked at once (each camera's own trigger
+// thread sends the command, so one that stopped answering holds up nobody), and two-trigger
+// cameras again when frame B starts, the plan's frame separation later (plus this event's Δt
+// error). With a trigger device the lines fire the cameras; they are only told to expect frames.
+void RigAcquisition::trigger_aravis_cameras(std::uint64_t index, std::int64_t dt_ns) {
+  if (!software_triggers_) {
+    for (std::size_t c = 0; c < aravis_cameras_.size(); ++c)
+      if (!free_running_[c] && aravis_cameras_[c]->connected()) aravis_cameras_[c]->note_hardware_trigger();
+    return;
+  }
+  // Frame B's trigger (two_triggers) follows A's by the plan's separation plus this event's
+  // Δt error; each camera's trigger thread times it from when its A trigger really went out.
+  const std::int64_t spacing = plan_.frame_separation_ns() + dt_ns - plan_.dt_ns;
+  for (std::size_t c = 0; c < aravis_cameras_.size(); ++c)
+    if (!free_running_[c] && aravis_cameras_[c]->connected()) aravis_cameras_[c]->request_software_trigger(index, spacing);
+}
+
+void RigAcquisition::report_mismatches() {
+  const auto stats = assembler_->statistics();
+  for (std::size_t c = 0; c < stats.cameras.size(); ++c) {
+    const auto& cam = stats.cameras[c];
+    if (cam.frames_mismatched == reported_mismatches_[c]) continue;
+    // The first mismatch of a camera, then one line per 100 frames, so a steady fault does not
+    // bury the status line.
+    if (reported_mismatches_[c] == 0 || cam.frames_mismatched / 200 != reported_mismatches_[c] / 200)
+      notice(fmt::format("{} ({} frames dropped so far)", cam.last_mismatch, cam.frames_mismatched));
+    reported_mismatches_[c] = cam.frames_mismatched;
+  }
 }
 
 void RigAcquisition::check_cameras(std::uint64_t index) {
   for (std::size_t c = 0; c < cameras_.size(); ++c) {
     if (reported_lost_[c] || cameras_[c]->connected()) continue;
     reported_lost_[c] = true;
+    assembler_->mark_camera_lost(c);  // sets stop waiting for its frames
+    const std::string problem = cameras_[c]->connection_problem();
+    const std::string cause = problem.empty() ? std::string() : fmt::format(" ({})", problem);
     if (options_.on_camera_loss == CameraLossPolicy::stop) {
-      const std::string why = fmt::format("camera {} vanished at trigger {}; stopping the run (--on-camera-loss stop)",
-                                          camera_ids_[c], index);
+      const std::string why = fmt::format("camera {} vanished at trigger {}{}; stopping the run (--on-camera-loss stop)",
+                                          camera_ids_[c], index, cause);
       notice(why);
       std::lock_guard lock(mutex_);
       if (failure_.empty()) failure_ = why;
       stop_requested_ = true;
     } else {
-      notice(fmt::format("camera {} vanished at trigger {}; continuing without it (--on-camera-loss continue), "
+      notice(fmt::format("camera {} vanished at trigger {}{}; continuing without it (--on-camera-loss continue), "
                          "its frames are recorded as missing",
-                         camera_ids_[c], index));
+                         camera_ids_[c], index, cause));
     }
   }
 }
 
 void RigAcquisition::finish_run() {
   device_->stop();
+  try {
+    announce_dropped_events(std::nullopt);  // the run's last dropped events still get their sets
+  } catch (const std::exception& e) {
+    std::lock_guard lock(mutex_);
+    if (failure_.empty()) failure_ = fmt::format("acquisition failed: {}", e.what());
+  }
+  // Real cameras deliver the last event's frames after its trigger: give them the set timeout
+  // to arrive before the streams close.
+  if (!aravis_cameras_.empty()) {
+    const auto give_up = Clock::now() + options_.set_timeout;
+    while (assembler_->pending() > 0 && Clock::now() < give_up) {
+      assembler_->expire();
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  }
   for (auto& camera : cameras_) camera->stop();
   assembler_->flush();
   finished_ = true;
@@ -231,10 +359,14 @@ RigProgress RigAcquisition::progress() const {
   RigProgress p;
   p.trigger_events = events_handled_;
   p.dropped_trigger_events = device_->dropped_events();
+  p.trigger_queue = device_->queued_events();
+  p.trigger_queue_capacity = device_->queue_capacity();
+  p.rate_hz = plan_.rate_hz;
   p.queued_sets = assembler_->queued();
   p.assembly = assembler_->statistics();
   for (std::size_t c = 0; c < cameras_.size(); ++c)
-    p.cameras.push_back({camera_ids_[c], cameras_[c]->connected(), cameras_[c]->statistics()});
+    p.cameras.push_back({camera_ids_[c], cameras_[c]->connected(), cameras_[c]->connection_problem(),
+                         free_running_[c], cameras_[c]->statistics()});
   return p;
 }
 

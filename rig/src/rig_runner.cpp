@@ -151,9 +151,14 @@ struct RigRunner::Impl {
 
 void RigRunner::Impl::refresh(bool final) {
   const RigProgress progress = acquisition.progress();
-  const std::uint64_t in_stream = sender.stats().sets_sent - receiver.stats().sets_received;
-  figures.queue_depth = progress.queued_sets + in_stream;
-  figures.dropped_trigger_events = progress.dropped_trigger_events;
+  // The receiver may count a set the sender's counter does not show yet: never below zero.
+  const std::uint64_t received = receiver.stats().sets_received;
+  figures.queue_depth = progress.queued_sets + sets_in_flight(sender.stats().sets_sent, received);
+  take_progress(figures, progress);
+  const std::filesystem::path out = options.recorder.out;
+  std::error_code ec;
+  const auto space = std::filesystem::space(out.has_parent_path() ? out.parent_path() : std::filesystem::path("."), ec);
+  if (!ec) figures.disk_free_bytes = space.available;
   status.update(figures, losses, final);
 }
 

@@ -379,8 +379,10 @@ void SessionReader::Impl::read_sets() {
                             "(present)",
                             s, info.cameras[k / 2].id, k % 2 == 0 ? 'A' : 'B', first[static_cast<std::ptrdiff_t>(k)]));
     const auto lost = std::count(first, first + static_cast<std::ptrdiff_t>(per_set), std::uint8_t{0});
+    // 2: a free-running camera's frame, present but not of this event: the set is not complete.
+    const auto unsynchronised = std::count(first, first + static_cast<std::ptrdiff_t>(per_set), std::uint8_t{2});
     missing += static_cast<int>(lost);
-    incomplete += lost > 0 ? 1 : 0;
+    incomplete += lost + unsynchronised > 0 ? 1 : 0;
   }
   check_frame_storage();
 }
@@ -452,11 +454,13 @@ SetRecord SessionReader::set_record(std::uint64_t set_index) const {
   const std::size_t n = m.cameras.size();
   r.frame_timestamp_ns.resize(n);
   r.frame_present.resize(n);
+  r.frame_synchronised.resize(n);
   for (std::size_t c = 0; c < n; ++c)
     for (std::size_t e = 0; e < 2; ++e) {
       const std::size_t k = (set_index * n + c) * 2 + e;
       r.frame_timestamp_ns[c][e] = m.frame_timestamp[k];
       r.frame_present[c][e] = m.frame_present[k] != 0;
+      r.frame_synchronised[c][e] = m.frame_present[k] != 2;
     }
   return r;
 }
@@ -480,6 +484,7 @@ FrameSet SessionReader::read_set(std::uint64_t set_index) const {
       const auto k = static_cast<std::size_t>(e);
       Frame& frame = frames[e];
       frame.timestamp_ns = record.frame_timestamp_ns[c][k];
+      frame.synchronised = record.frame_synchronised[c][k];
       if (!record.frame_present[c][k]) continue;  // lost when recorded: stays empty
       frame.image = uninitialised_image(camera.width, camera.height, ds.sample_type);
       const std::array<hsize_t, 4> offset{set_index, k, 0, 0};

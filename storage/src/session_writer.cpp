@@ -317,7 +317,7 @@ void SessionWriter::Impl::collect(const FrameSet& set) {
                                     final_path.string(), camera.width, camera.height,
                                     to_string(sample_type_of(camera.pixel_format)), to_string(camera.pixel_format)));
       frames_[slot] = &frame;
-      present_[slot] = 1;
+      present_[slot] = frame.synchronised ? 1 : 2;  // 2: present, not exposed by this event (free-running)
     }
   }
 }

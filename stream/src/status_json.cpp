@@ -21,12 +21,29 @@ T field(const json& object, const char* key, const char* where = "status") {
   }
 }
 
+// Keys added within version 1: a message from an older sender lacks them, and keeps the default.
+template <typename T>
+void optional_field(const json& object, const char* key, T& out, const char* where = "status") {
+  if (object.contains(key)) out = field<T>(object, key, where);
+}
+
 }  // namespace
 
 std::string to_json(const Status& s) {
   json cameras = json::array();
   for (const auto& c : s.cameras)
-    cameras.push_back({{"id", c.camera_id}, {"frames_lost", c.frames_lost}, {"incomplete_sets", c.incomplete_sets}});
+    cameras.push_back({{"id", c.camera_id},
+                       {"frames_lost", c.frames_lost},
+                       {"incomplete_sets", c.incomplete_sets},
+                       {"connected", c.connected},
+                       {"problem", c.problem},
+                       {"free_running", c.free_running},
+                       {"frames", c.frames},
+                       {"underruns", c.underruns},
+                       {"failed", c.failed},
+                       {"missing_packets", c.missing_packets},
+                       {"resends", c.resends},
+                       {"mismatched", c.mismatched}});
   const json j = {{"type", kStatusType},
                   {"version", kStatusVersion},
                   {"time_ns", s.time_ns},
@@ -39,6 +56,13 @@ std::string to_json(const Status& s) {
                   {"preview_drops", s.preview_drops},
                   {"queue_depth", s.queue_depth},
                   {"disk_mb_per_second", s.disk_mb_per_second},
+                  {"dropped_trigger_events", s.dropped_trigger_events},
+                  {"trigger_lag_events", s.trigger_lag_events},
+                  {"trigger_lag_ms", s.trigger_lag_ms},
+                  {"trigger_queue_capacity", s.trigger_queue_capacity},
+                  {"disk_free_bytes", s.disk_free_bytes},
+                  {"disk_minutes_until_full", s.disk_minutes_until_full},
+                  {"warnings", s.warnings},
                   {"cameras", cameras}};
   return j.dump();
 }
@@ -68,13 +92,31 @@ Status parse_status(std::string_view text) {
   s.preview_drops = field<std::uint64_t>(j, "preview_drops");
   s.queue_depth = field<std::uint64_t>(j, "queue_depth");
   s.disk_mb_per_second = field<double>(j, "disk_mb_per_second");
+  optional_field(j, "dropped_trigger_events", s.dropped_trigger_events);
+  optional_field(j, "trigger_lag_events", s.trigger_lag_events);
+  optional_field(j, "trigger_lag_ms", s.trigger_lag_ms);
+  optional_field(j, "trigger_queue_capacity", s.trigger_queue_capacity);
+  optional_field(j, "disk_free_bytes", s.disk_free_bytes);
+  optional_field(j, "disk_minutes_until_full", s.disk_minutes_until_full);
+  optional_field(j, "warnings", s.warnings);
   const auto cameras = field<json>(j, "cameras");
   if (!cameras.is_array()) throw bad_input("status key 'cameras' must be an array");
   for (const auto& c : cameras) {
     if (!c.is_object()) throw bad_input("status 'cameras' entries must be objects");
-    s.cameras.push_back({field<std::string>(c, "id", "status camera"),
-                         field<std::uint64_t>(c, "frames_lost", "status camera"),
-                         field<std::uint64_t>(c, "incomplete_sets", "status camera")});
+    CameraStatus cam;
+    cam.camera_id = field<std::string>(c, "id", "status camera");
+    cam.frames_lost = field<std::uint64_t>(c, "frames_lost", "status camera");
+    cam.incomplete_sets = field<std::uint64_t>(c, "incomplete_sets", "status camera");
+    optional_field(c, "connected", cam.connected, "status camera");
+    optional_field(c, "problem", cam.problem, "status camera");
+    optional_field(c, "free_running", cam.free_running, "status camera");
+    optional_field(c, "frames", cam.frames, "status camera");
+    optional_field(c, "underruns", cam.underruns, "status camera");
+    optional_field(c, "failed", cam.failed, "status camera");
+    optional_field(c, "missing_packets", cam.missing_packets, "status camera");
+    optional_field(c, "resends", cam.resends, "status camera");
+    optional_field(c, "mismatched", cam.mismatched, "status camera");
+    s.cameras.push_back(std::move(cam));
   }
   return s;
 }

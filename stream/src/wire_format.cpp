@@ -19,6 +19,8 @@ using detail::ByteReader;
 using detail::ByteWriter;
 
 constexpr std::uint8_t kFlagPresent = 0x01;
+// A free-running camera's frame: present, but not exposed by this set's trigger event.
+constexpr std::uint8_t kFlagUnsynchronised = 0x02;
 
 WirePixelFormat wire_format_of(SampleType type) {
   switch (type) {
@@ -60,7 +62,7 @@ void write_frame_entry(ByteWriter& w, std::uint16_t camera, Exposure exposure, c
   w.u16(camera);
   w.u8(static_cast<std::uint8_t>(exposure));
   w.u8(static_cast<std::uint8_t>(im.empty() ? WirePixelFormat::none : wire_format_of(im.type())));
-  w.u8(im.empty() ? 0 : kFlagPresent);
+  w.u8(im.empty() ? 0 : static_cast<std::uint8_t>(kFlagPresent | (frame.synchronised ? 0 : kFlagUnsynchronised)));
   w.u8(0);
   w.u16(0);
   w.u32(im.empty() ? 0 : static_cast<std::uint32_t>(im.width()));
@@ -246,13 +248,14 @@ FrameSet decode_frame_set(std::vector<zmq::message_t>&& parts) {
                                   camera_count));
     if (e.exposure > 1)
       throw bad_input(fmt::format("frame entry {} has exposure code {}; expected 0 (A) or 1 (B)", i, e.exposure));
-    if ((e.flags & ~kFlagPresent) != 0)
+    if ((e.flags & ~(kFlagPresent | kFlagUnsynchronised)) != 0)
       throw bad_input(fmt::format("{} has unknown flag bits 0x{:02x}", frame_name(i, e), e.flags));
     const std::size_t slot = 2u * e.camera + e.exposure;
     if (seen[slot]) throw bad_input(frame_name(i, e) + " repeats a frame already in the header");
     seen[slot] = true;
     Frame& frame = set.cameras[e.camera][static_cast<Exposure>(e.exposure)];
     frame.timestamp_ns = e.timestamp_ns;
+    frame.synchronised = (e.flags & kFlagUnsynchronised) == 0;
     frame.image = image_from_part(i, e, std::move(parts[1 + i]));
   }
   return set;

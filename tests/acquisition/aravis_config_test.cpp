@@ -27,7 +27,7 @@ config::CameraConfig fake_config(const std::string& id = "cam0") {
 
 AravisCameraOptions free_running() {
   AravisCameraOptions o;
-  o.trigger_mode = "Off";
+  o.frame_mode = config::FrameMode::free_run;
   o.buffer_count = 3;
   return o;
 }
@@ -79,7 +79,7 @@ TEST_F(AravisFakeInterface, UnknownFeatureAndRefusedValueNameTheFeature) {
   EXPECT_TRUE(contains(msg, "Width")) << msg;
 
   AravisCameraOptions opt = free_running();
-  opt.trigger_mode = "On";
+  opt.frame_mode = config::FrameMode::two_triggers;
   opt.trigger_source = "Line42";
   AravisCamera triggered("cam1", opt);
   msg = error_of([&] { triggered.configure(fake_config("cam1")); }, ErrorKind::bad_input);

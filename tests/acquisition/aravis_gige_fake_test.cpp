@@ -218,7 +218,7 @@ class GigEFakeCameras : public ::testing::Test {
   static AravisCameraOptions software_triggered() {
     AravisCameraOptions o;
     o.trigger_source = "Software";
-    o.mode = DoubleFrameMode::two_triggers;  // the fake takes one frame per trigger
+    o.frame_mode = config::FrameMode::two_triggers;  // the fake takes one frame per trigger
     o.socket_buffer_bytes = 1 << 20;
     return o;
   }

@@ -70,9 +70,10 @@ TEST(FrameSetAssembler, EmitsCompleteSetsAsSoonAsAllFramesArrived) {
     EXPECT_EQ(set->cameras[1].camera_id, "cam1");
     for (std::size_t c = 0; c < 2; ++c)
       for (Exposure e : {Exposure::A, Exposure::B}) expect_tagged(*set, c, e);
-    // No trigger was given: timing falls back on camera frame A and B timestamps.
-    EXPECT_EQ(set->trigger_timestamp_ns, static_cast<std::int64_t>(k) * 100'000'000);
-    EXPECT_EQ(set->dt_ns, 50'000);
+    // No trigger was given: the trigger time stays unknown (0), never a camera's clock, which
+    // would put one file's trigger_timestamp_ns on two clocks.
+    EXPECT_EQ(set->trigger_timestamp_ns, 0);
+    EXPECT_EQ(set->dt_ns, 0);
   }
   const auto s = a.statistics();
   EXPECT_EQ(s.sets_complete, 3u);
@@ -271,6 +272,110 @@ TEST(FrameSetAssembler, ConcurrentCamerasAndAConsumerLoseNothing) {
   const auto s = a.statistics();
   EXPECT_EQ(s.sets_complete, kSets);
   for (const auto& c : s.cameras) EXPECT_EQ(c.frames_missing + c.frames_late + c.frames_duplicate, 0u) << c.camera_id;
+}
+
+}  // namespace
+}  // namespace tomorig::acquisition
+
+// Pairing by time, the run's end, lost cameras and free-running cameras.
+namespace tomorig::acquisition {
+namespace {
+
+CameraFrame frame_at(std::size_t camera, std::uint64_t index, Exposure e, std::int64_t timestamp_ns) {
+  CameraFrame f = make_frame(camera, index, e);
+  f.timestamp_ns = timestamp_ns;
+  return f;
+}
+
+TEST(FrameSetAssemblerPairing, APairWhoseTimestampsDisagreeWithThePlanIsDroppedAndTheSetFlagged) {
+  ManualClock clock;
+  AssemblerOptions o = two_cameras();
+  // The plan: B 60 ms after A, give or take 25 ms; camera 1 unchecked (tolerance 0).
+  o.pairing = {{60'000'000, 25'000'000, false}, {}};
+  FrameSetAssembler a(o, clock.fn());
+  // Set 0: camera 0 pairs right (B - A = 80 ms, within 60 ± 25).
+  a.add_frame(0, frame_at(0, 0, Exposure::A, 1'000'000'000));
+  a.add_frame(0, frame_at(0, 0, Exposure::B, 1'080'000'000));
+  add_pair(a, 1, 0);
+  auto good = a.try_pop();
+  ASSERT_TRUE(good);
+  EXPECT_TRUE(good->complete());
+  // Set 1: camera 0 missed a trigger, so its "B" is the next event's frame A, 140 ms later.
+  a.add_frame(0, frame_at(0, 1, Exposure::A, 1'200'000'000));
+  a.add_frame(0, frame_at(0, 1, Exposure::B, 1'340'000'000));
+  add_pair(a, 1, 1);
+  auto bad = a.try_pop();
+  ASSERT_TRUE(bad);
+  EXPECT_FALSE(bad->complete());
+  EXPECT_FALSE(bad->cameras[0].a.present());  // neither frame of the mismatched pair is kept
+  EXPECT_FALSE(bad->cameras[0].b.present());
+  expect_tagged(*bad, 1, Exposure::A);
+  const auto s = a.statistics();
+  EXPECT_EQ(s.cameras[0].frames_mismatched, 2u);
+  EXPECT_EQ(s.cameras[0].frames_missing, 2u);
+  EXPECT_EQ(s.cameras[0].frames_received, 2u);  // set 0's pair
+  EXPECT_EQ(s.sets_incomplete, 1u);
+  EXPECT_NE(s.cameras[0].last_mismatch.find("140.000 ms apart"), std::string::npos) << s.cameras[0].last_mismatch;
+  EXPECT_NE(s.cameras[0].last_mismatch.find("60.000 ms"), std::string::npos) << s.cameras[0].last_mismatch;
+}
+
+TEST(FrameSetAssemblerPairing, NeverMoreSetsThanTheRunAsked) {
+  ManualClock clock;
+  AssemblerOptions o = two_cameras();
+  o.end_trigger_index = 2;
+  FrameSetAssembler a(o, clock.fn());
+  for (std::uint64_t k = 0; k < 4; ++k) {  // the cameras deliver two events too many
+    add_pair(a, 0, k);
+    add_pair(a, 1, k);
+  }
+  a.add_trigger({3, 300, 100});  // and the trigger announces one past the end
+  a.flush();
+  int sets = 0;
+  while (auto set = a.try_pop()) {
+    EXPECT_LT(set->trigger_index, 2u);
+    ++sets;
+  }
+  EXPECT_EQ(sets, 2);
+  EXPECT_EQ(a.statistics().cameras[0].frames_beyond_run, 4u);
+}
+
+TEST(FrameSetAssemblerPairing, SetsStopWaitingForALostCamera) {
+  ManualClock clock;
+  FrameSetAssembler a(two_cameras(), clock.fn());
+  add_pair(a, 0, 0);
+  EXPECT_FALSE(a.try_pop());
+  a.mark_camera_lost(1);  // camera 1 is gone: no point waiting out the timeout
+  auto set = a.try_pop();
+  ASSERT_TRUE(set);
+  EXPECT_EQ(set->missing_frames(), 2);
+  EXPECT_TRUE(a.statistics().cameras[1].lost);
+  add_pair(a, 0, 1);
+  EXPECT_TRUE(a.try_pop()) << "a later set waited for the lost camera";
+}
+
+TEST(FrameSetAssemblerPairing, FreeRunningFramesFillAnnouncedSetsAndNeverMakeThemComplete) {
+  ManualClock clock;
+  AssemblerOptions o = two_cameras();
+  o.pairing = {{}, {0, 0, true}};  // camera 1 runs free
+  FrameSetAssembler a(o, clock.fn());
+  a.add_frame(1, make_frame(1, 7, Exposure::A));  // before any event: no set waits for it
+  clock.now_ns = 10;
+  a.add_trigger({0, 1000, 100});
+  add_pair(a, 0, 0);
+  a.add_frame(1, make_frame(1, 99, Exposure::A));  // its own numbering means nothing
+  a.add_frame(1, make_frame(1, 99, Exposure::B));
+  auto set = a.try_pop();
+  ASSERT_TRUE(set);
+  EXPECT_EQ(set->missing_frames(), 0);
+  EXPECT_TRUE(set->cameras[1].a.present() && set->cameras[1].b.present());
+  EXPECT_FALSE(set->cameras[1].a.synchronised);
+  EXPECT_TRUE(set->cameras[0].a.synchronised);
+  EXPECT_EQ(set->unsynchronised_frames(), 2);
+  EXPECT_FALSE(set->complete());
+  const auto s = a.statistics();
+  EXPECT_EQ(s.cameras[1].frames_surplus, 1u);
+  EXPECT_EQ(s.sets_incomplete, 1u);
+  EXPECT_EQ(s.sets_complete, 0u);
 }
 
 }  // namespace

@@ -167,7 +167,7 @@ backend = "aravis"
 device_id = "Basler-1234"
 pixel_format = "Mono12"
 [cameras.features]
-ExposureTime = 200.0
+ExposureTime = 20.0
 Gain = 3
 ReverseX = true
 GainAuto = "Off"
@@ -200,7 +200,7 @@ iterations = 20
   EXPECT_EQ(cam.device_id, "Basler-1234");
   EXPECT_EQ(cam.pixel_format, PixelFormat::Mono12);
   EXPECT_EQ(cam.roi.width, 0);  // no ROI: the full sensor
-  EXPECT_EQ(cam.features.at("ExposureTime"), "200");
+  EXPECT_EQ(cam.features.at("ExposureTime"), "20");  // what [trigger.camera] exposure_a_us says (default 20)
   EXPECT_EQ(cam.features.at("Gain"), "3");
   EXPECT_EQ(cam.features.at("ReverseX"), "true");
   EXPECT_EQ(cam.features.at("GainAuto"), "Off");

@@ -148,3 +148,38 @@ TEST(SimulatedDevice, UsageErrors) {
 
 }  // namespace
 }  // namespace tomorig::trigger
+
+namespace tomorig::trigger {
+namespace {
+
+// A dropped event is still a real event: its set must get its own time and Δt, not zeros.
+TEST(SimulatedDevice, DroppedEventsKeepTheirTimesForTheConsumer) {
+  SimulatedTriggerOptions options;
+  options.pacing = Pacing::real_time;
+  options.clock = std::make_shared<test::VirtualClock>();
+  auto device = std::make_unique<TriggerDevice>(make_simulated_backend(options), test::led_rig().light_sources, 2);
+  device->arm(plan_timing(test::led_rig()));
+  EXPECT_EQ(device->queue_capacity(), 2u);
+  device->start(20);
+  std::vector<TriggerEvent> events;
+  while (auto e = device->next_event()) events.push_back(*e);
+  const std::vector<TriggerEvent> dropped = device->take_dropped_events();
+  ASSERT_EQ(dropped.size(), device->dropped_events());
+  ASSERT_EQ(events.size() + dropped.size(), 20u);
+  std::vector<bool> seen(20, false);
+  for (const auto& e : events) seen[e.index] = true;
+  for (std::size_t i = 0; i < dropped.size(); ++i) {
+    const TriggerEvent& e = dropped[i];
+    EXPECT_FALSE(seen[e.index]) << "event " << e.index << " both delivered and dropped";
+    seen[e.index] = true;
+    if (i > 0) EXPECT_GT(e.index, dropped[i - 1].index);  // oldest first
+    EXPECT_EQ(e.timestamp_ns, static_cast<std::int64_t>(e.index) * 100'000'000);
+    EXPECT_EQ(e.dt_ns, 100'000);
+    EXPECT_EQ(e.pulse1_ns, e.timestamp_ns + 11'000);
+  }
+  EXPECT_TRUE(device->take_dropped_events().empty());  // each one is handed over once
+  EXPECT_EQ(device->queued_events(), 0u);
+}
+
+}  // namespace
+}  // namespace tomorig::trigger

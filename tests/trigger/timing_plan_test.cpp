@@ -178,3 +178,75 @@ TEST(TimingPlanInfeasible, FlashLampWithoutQSwitch) {
 
 }  // namespace
 }  // namespace tomorig::trigger
+
+// Single-frame cameras triggered twice (frame_mode "two_triggers"): one trigger per frame,
+// each frame centred on its pulse, frame B no earlier than the camera's readout after A.
+namespace tomorig::trigger {
+namespace {
+
+TimingInputs two_trigger_rig(std::int64_t dt_ns, std::int64_t readout_ns) {
+  TimingInputs in = test::led_rig();
+  in.rate_hz = 5.0;
+  in.dt_ns = dt_ns;
+  in.camera.mode = FrameMode::two_triggers;
+  in.camera.exposure_a_ns = 1'000'000;  // 1 ms per frame
+  in.camera.readout_ns = readout_ns;
+  return in;
+}
+
+TEST(TimingPlanTwoTriggers, EachFrameIsCentredOnItsPulseAndTheCameraIsTriggeredTwice) {
+  // dt 60 ms, readout 40 ms: centred frames leave 59 ms between A's end and B's start.
+  const TimingPlan plan = plan_timing(two_trigger_rig(60'000'000, 40'000'000));
+  EXPECT_EQ(plan.camera.mode, FrameMode::two_triggers);
+  EXPECT_TRUE(inside(plan.light_pulse_1, plan.frame_a));
+  EXPECT_TRUE(inside(plan.light_pulse_2, plan.frame_b));
+  EXPECT_EQ(plan.frame_a.width_ns(), 1'000'000);
+  EXPECT_EQ(plan.frame_b.width_ns(), 1'000'000);  // one ExposureTime for both frames
+  // Centred: pulse centre in the frame's middle, so B - A is dt exactly.
+  EXPECT_EQ(plan.frame_separation_ns(), 60'000'000);
+  EXPECT_EQ((plan.frame_a.rise_ns + plan.frame_a.fall_ns) / 2,
+            (plan.light_pulse_1.rise_ns + plan.light_pulse_1.fall_ns) / 2);
+  EXPECT_EQ(plan.straddle_margin_ns, (1'000'000 - 1'000) / 2);
+  const ChannelTiming* cam = plan.find_channel("cam");
+  ASSERT_NE(cam, nullptr);
+  ASSERT_EQ(cam->pulses.size(), 2u);  // frame A's trigger and frame B's
+  EXPECT_EQ(cam->pulses[1].rise_ns - cam->pulses[0].rise_ns, 60'000'000);
+  EXPECT_EQ(cam->pulses[0].rise_ns, plan.frame_a.rise_ns - 1'000);  // early by the camera's delay
+}
+
+TEST(TimingPlanTwoTriggers, FramesMoveApartWhenTheReadoutNeedsIt) {
+  // dt 40.5 ms, readout 40 ms: centred frames leave 39.5 ms, so A moves 0.25 ms earlier and B
+  // 0.25 ms later; each pulse stays inside its frame with 0.2495 ms to spare.
+  const TimingPlan plan = plan_timing(two_trigger_rig(40'500'000, 40'000'000));
+  EXPECT_EQ(plan.frame_b.rise_ns - plan.frame_a.fall_ns, 40'000'000);
+  EXPECT_TRUE(inside(plan.light_pulse_1, plan.frame_a));
+  EXPECT_TRUE(inside(plan.light_pulse_2, plan.frame_b));
+  EXPECT_EQ(plan.straddle_margin_ns, 249'500);
+}
+
+TEST(TimingPlanTwoTriggers, DtShorterThanTheReadoutIsRefusedAndSaysWhy) {
+  const std::string msg = refusal(two_trigger_rig(30'000'000, 40'000'000));
+  EXPECT_NE(msg.find("readout time 40000 us"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("two_triggers"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("dt must be >= 40001 us"), std::string::npos) << msg;  // readout + the 1 us pulse
+}
+
+TEST(TimingPlanTwoTriggers, ReadoutOfFrameBMustEndBeforeTheNextEvent) {
+  TimingInputs in = two_trigger_rig(150'000'000, 80'000'000);  // B ends ~150 ms, + 80 ms readout > 200 ms
+  const std::string msg = refusal(in);
+  EXPECT_NE(msg.find("and its readout"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("longer than the period"), std::string::npos) << msg;
+}
+
+TEST(TimingPlanTwoTriggers, NeedsAReadoutTime) {
+  const std::string msg = refusal(two_trigger_rig(60'000'000, 0));
+  EXPECT_NE(msg.find("readout time"), std::string::npos) << msg;
+}
+
+TEST(TimingPlanTwoTriggers, HardwareDoubleFrameSeparationIsExposureAPlusInterframe) {
+  const TimingPlan plan = plan_timing(test::led_rig());
+  EXPECT_EQ(plan.frame_separation_ns(), 20'000 + 120);
+}
+
+}  // namespace
+}  // namespace tomorig::trigger

@@ -41,8 +41,13 @@ std::string timing_diagram(const TimingPlan& plan, const DeviceCapabilities& dev
   out += fmt::format("trigger plan: {:.6g} Hz (period {}), dt {} (pulse centre to centre), straddle margin +/- {}\n",
                      plan.rate_hz, format_us(plan.period_ns), format_us(plan.dt_ns),
                      format_us(plan.straddle_margin_ns));
-  out += fmt::format("camera: exposure A {}, interframe {}, exposure B {}\n", format_us(plan.camera.exposure_a_ns),
-                     format_us(plan.camera.interframe_ns), format_us(plan.camera.exposure_b_ns));
+  if (plan.camera.mode == FrameMode::two_triggers)
+    out += fmt::format("camera: single-frame, two triggers: exposure {} per frame, readout {}, B - A {}\n",
+                       format_us(plan.camera.exposure_a_ns), format_us(plan.camera.readout_ns),
+                       format_us(plan.frame_separation_ns()));
+  else
+    out += fmt::format("camera: exposure A {}, interframe {}, exposure B {}\n", format_us(plan.camera.exposure_a_ns),
+                       format_us(plan.camera.interframe_ns), format_us(plan.camera.exposure_b_ns));
   out += fmt::format("device: {} ({} channels, resolution {}, jitter {}, minimum pulse {})\n", device.device,
                      device.max_channels, format_us(device.resolution_ns), format_us(device.jitter_ns),
                      format_us(device.min_pulse_ns));

@@ -64,6 +64,11 @@ RigTrigger rig_trigger(const config::RigConfig& rig) {
   out.inputs.camera.exposure_a_ns = us_to_ns(t.camera.exposure_a_us);
   out.inputs.camera.interframe_ns = us_to_ns(t.camera.interframe_us);
   out.inputs.camera.exposure_b_ns = us_to_ns(t.camera.exposure_b_us);
+  out.inputs.camera.readout_ns = us_to_ns(t.camera.readout_us);
+  // The triggered cameras share one frame mode (the config checks it); free-running cameras
+  // take no trigger and have no place in the plan.
+  for (const auto& cam : rig.cameras)
+    if (cam.frame_mode == config::FrameMode::two_triggers) out.inputs.camera.mode = FrameMode::two_triggers;
   out.simulated.jitter_ns = t.jitter_ns;
   if (rig.simulation) out.simulated.seed = rig.simulation->seed;
   out.gpio.resolution_ns = us_to_ns(t.gpio_resolution_us);

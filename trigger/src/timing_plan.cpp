@@ -49,6 +49,9 @@ void check_inputs(const TimingInputs& in, Problems& problems) {
   if (in.camera.exposure_b_ns <= 0) problems.add("camera exposure B {} must be > 0", format_us(in.camera.exposure_b_ns));
   if (in.camera.interframe_ns < 0)
     problems.add("camera interframe time {} must be >= 0", format_us(in.camera.interframe_ns));
+  if (in.camera.mode == FrameMode::two_triggers && in.camera.readout_ns <= 0)
+    problems.add("frame mode two_triggers needs the camera's readout time (> 0): a single-frame camera cannot take "
+                 "the second trigger before frame A is read out");
 
   std::set<std::string> sources;
   for (const auto& s : in.light_sources) {
@@ -122,6 +125,79 @@ void shift(Pulse& p, std::int64_t by) {
   p.fall_ns += by;
 }
 
+
+// Double-frame camera: x is the end of frame A. Pulse 1 inside A and pulse 2 inside B give
+// four bounds; x goes in the middle of what they leave, so jitter either way has the same slack.
+void place_double_frame_windows(const TimingInputs& in, const Pulse& p1, const Pulse& p2, TimingPlan& plan,
+                                Problems& problems) {
+  const auto& cam = in.camera;
+  const std::int64_t lo = std::max(p1.fall_ns, p2.fall_ns - cam.interframe_ns - cam.exposure_b_ns);
+  const std::int64_t hi = std::min(p1.rise_ns + cam.exposure_a_ns, p2.rise_ns - cam.interframe_ns);
+  if (lo > hi) {
+    const std::int64_t gap = p2.rise_ns - p1.fall_ns;
+    if (gap < cam.interframe_ns)
+      problems.add("dt {} is too short for the camera: between light pulse 1 and pulse 2 there are {}, less than the "
+                   "interframe time {}; dt must be >= {}",
+                   format_us(in.dt_ns), format_us(gap), format_us(cam.interframe_ns),
+                   format_us(in.dt_ns + cam.interframe_ns - gap));
+    if (p1.width_ns() > cam.exposure_a_ns)
+      problems.add("light pulse 1 ({} wide) does not fit in the frame A exposure {}; exposure A must be >= {}",
+                   format_us(p1.width_ns()), format_us(cam.exposure_a_ns), format_us(p1.width_ns()));
+    if (p2.width_ns() > cam.exposure_b_ns)
+      problems.add("light pulse 2 ({} wide) does not fit in the frame B exposure {}; exposure B must be >= {}",
+                   format_us(p2.width_ns()), format_us(cam.exposure_b_ns), format_us(p2.width_ns()));
+    const std::int64_t span = p2.fall_ns - p1.rise_ns;
+    const std::int64_t window = cam.exposure_a_ns + cam.interframe_ns + cam.exposure_b_ns;
+    if (span > window)
+      problems.add("dt {} is too long for the camera: the pulses span {} but frame A + interframe + frame B last {}; "
+                   "dt must be <= {}",
+                   format_us(in.dt_ns), format_us(span), format_us(window), format_us(in.dt_ns - (span - window)));
+    problems.throw_if_any();
+  }
+  const std::int64_t frame_a_end = lo + (hi - lo) / 2;
+  plan.straddle_margin_ns = (hi - lo) / 2;
+  plan.frame_a = {frame_a_end - cam.exposure_a_ns, frame_a_end};
+  plan.frame_b = {frame_a_end + cam.interframe_ns, frame_a_end + cam.interframe_ns + cam.exposure_b_ns};
+}
+
+// Single-frame camera triggered twice: frames A and B both last exposure A (the camera has one
+// ExposureTime), each centred on its pulse when the readout allows; otherwise A moves earlier
+// and B later by the same amount until the readout fits between them. What is left of either
+// frame's slack around its pulse is the straddle margin.
+void place_single_frame_windows(const TimingInputs& in, const Pulse& p1, const Pulse& p2, TimingPlan& plan,
+                                Problems& problems) {
+  const auto& cam = in.camera;
+  const std::int64_t exposure = cam.exposure_a_ns;
+  for (const auto& [k, p] : {std::pair{1, p1}, std::pair{2, p2}})
+    if (p.width_ns() > exposure)
+      problems.add("light pulse {} ({} wide) does not fit in the exposure {} of a frame; exposure A (both frames of a "
+                   "two_triggers camera) must be >= {}",
+                   k, format_us(p.width_ns()), format_us(exposure), format_us(p.width_ns()));
+  const std::int64_t gap = p2.rise_ns - p1.fall_ns;  // the most the camera can have between A's end and B's start
+  if (gap < cam.readout_ns)
+    problems.add("dt {} is too short for single-frame cameras triggered twice (frame_mode two_triggers): between light "
+                 "pulse 1 and pulse 2 there are {}, less than the camera's readout time {}, so frame B could not "
+                 "start before pulse 2; dt must be >= {} (or use double-frame cameras, frame_mode hardware)",
+                 format_us(in.dt_ns), format_us(gap), format_us(cam.readout_ns),
+                 format_us(in.dt_ns + cam.readout_ns - gap));
+  problems.throw_if_any();
+  // Centred: A ends at the middle of [p1.fall, p1.rise + exposure], B starts at the middle of
+  // [p2.fall - exposure, p2.rise].
+  std::int64_t a_end = p1.fall_ns + (p1.rise_ns + exposure - p1.fall_ns) / 2;
+  std::int64_t b_start = p2.fall_ns - exposure + (p2.rise_ns - (p2.fall_ns - exposure)) / 2;
+  const std::int64_t short_by = cam.readout_ns - (b_start - a_end);
+  if (short_by > 0) {
+    a_end -= short_by / 2;
+    b_start += short_by - short_by / 2;
+  }
+  a_end = std::max(a_end, p1.fall_ns);
+  b_start = std::min(b_start, p2.rise_ns);
+  plan.frame_a = {a_end - exposure, a_end};
+  plan.frame_b = {b_start, b_start + exposure};
+  plan.straddle_margin_ns = std::min({a_end - p1.fall_ns, p1.rise_ns - plan.frame_a.rise_ns, b_start + exposure - p2.fall_ns,
+                                      p2.rise_ns - b_start});
+}
+
 }  // namespace
 
 std::string format_us(std::int64_t ns) {
@@ -129,6 +205,10 @@ std::string format_us(std::int64_t ns) {
   while (!s.empty() && s.back() == '0') s.pop_back();
   if (!s.empty() && s.back() == '.') s.pop_back();
   return s + " us";
+}
+
+std::string_view to_string(FrameMode mode) {
+  return mode == FrameMode::two_triggers ? "two_triggers" : "hardware";
 }
 
 std::string_view to_string(ChannelRole role) {
@@ -186,36 +266,11 @@ TimingPlan plan_timing(const TimingInputs& in) {
   plan.light_pulse_1 = p1;
   plan.light_pulse_2 = p2;
 
-  // 2. Camera: x is the end of frame A. Pulse 1 inside A and pulse 2 inside B give four bounds;
-  //    x goes in the middle of what they leave, so jitter either way has the same slack.
-  const auto& cam = in.camera;
-  const std::int64_t lo = std::max(p1.fall_ns, p2.fall_ns - cam.interframe_ns - cam.exposure_b_ns);
-  const std::int64_t hi = std::min(p1.rise_ns + cam.exposure_a_ns, p2.rise_ns - cam.interframe_ns);
-  if (lo > hi) {
-    const std::int64_t gap = p2.rise_ns - p1.fall_ns;
-    if (gap < cam.interframe_ns)
-      problems.add("dt {} is too short for the camera: between light pulse 1 and pulse 2 there are {}, less than the "
-                   "interframe time {}; dt must be >= {}",
-                   format_us(in.dt_ns), format_us(gap), format_us(cam.interframe_ns),
-                   format_us(in.dt_ns + cam.interframe_ns - gap));
-    if (p1.width_ns() > cam.exposure_a_ns)
-      problems.add("light pulse 1 ({} wide) does not fit in the frame A exposure {}; exposure A must be >= {}",
-                   format_us(p1.width_ns()), format_us(cam.exposure_a_ns), format_us(p1.width_ns()));
-    if (p2.width_ns() > cam.exposure_b_ns)
-      problems.add("light pulse 2 ({} wide) does not fit in the frame B exposure {}; exposure B must be >= {}",
-                   format_us(p2.width_ns()), format_us(cam.exposure_b_ns), format_us(p2.width_ns()));
-    const std::int64_t span = p2.fall_ns - p1.rise_ns;
-    const std::int64_t window = cam.exposure_a_ns + cam.interframe_ns + cam.exposure_b_ns;
-    if (span > window)
-      problems.add("dt {} is too long for the camera: the pulses span {} but frame A + interframe + frame B last {}; "
-                   "dt must be <= {}",
-                   format_us(in.dt_ns), format_us(span), format_us(window), format_us(in.dt_ns - (span - window)));
-    problems.throw_if_any();
-  }
-  const std::int64_t frame_a_end = lo + (hi - lo) / 2;
-  plan.straddle_margin_ns = (hi - lo) / 2;
-  plan.frame_a = {frame_a_end - cam.exposure_a_ns, frame_a_end};
-  plan.frame_b = {frame_a_end + cam.interframe_ns, frame_a_end + cam.interframe_ns + cam.exposure_b_ns};
+  // 2. Camera windows.
+  if (in.camera.mode == FrameMode::two_triggers)
+    place_single_frame_windows(in, p1, p2, plan, problems);
+  else
+    place_double_frame_windows(in, p1, p2, plan, problems);
 
   // 3. Electrical edges, early by each channel's delay. Light before flash lamps (a flash lamp
   //    leads its Q-switch edge) before the pulse generator (which leads everything it makes).
@@ -226,6 +281,8 @@ TimingPlan plan_timing(const TimingInputs& in) {
     const std::int64_t width = c.width_ns > 0 ? c.width_ns : kDefaultOutputWidthNs;
     if (c.role == ChannelRole::camera) {
       ch.pulses.push_back({plan.frame_a.rise_ns - c.delay_ns, plan.frame_a.rise_ns - c.delay_ns + width});
+      if (in.camera.mode == FrameMode::two_triggers)  // the second trigger starts frame B
+        ch.pulses.push_back({plan.frame_b.rise_ns - c.delay_ns, plan.frame_b.rise_ns - c.delay_ns + width});
     } else if (c.role == ChannelRole::light) {
       const LightSource& s = source_of(in, c);
       const std::int64_t w = c.width_ns > 0 ? c.width_ns : s.pulse_width_ns;
@@ -285,13 +342,15 @@ TimingPlan plan_timing(const TimingInputs& in) {
                      ch.spec.name, format_us(ch.pulses[k].rise_ns), format_us(ch.pulses[k - 1].fall_ns),
                      format_us(in.dt_ns + ch.pulses[k - 1].fall_ns - ch.pulses[k].rise_ns));
   }
-  std::int64_t last = plan.frame_b.fall_ns;
+  // A single-frame camera must have read frame B out before the next event's first trigger.
+  std::int64_t last = plan.frame_b.fall_ns + (in.camera.mode == FrameMode::two_triggers ? in.camera.readout_ns : 0);
   for (const auto& ch : plan.channels)
     for (const auto& p : ch.pulses) last = std::max(last, p.fall_ns);
   if (last > plan.period_ns)
-    problems.add("one event needs {} (first edge to the end of frame B or the last edge), longer than the period {} "
+    problems.add("one event needs {} (first edge to the end of frame B{} or the last edge), longer than the period {} "
                  "at {} Hz; lower the rate to <= {:.6g} Hz or shorten exposure B / flash-lamp lead",
-                 format_us(last), format_us(plan.period_ns), in.rate_hz, 1e9 / static_cast<double>(last));
+                 format_us(last), in.camera.mode == FrameMode::two_triggers ? " and its readout" : "",
+                 format_us(plan.period_ns), in.rate_hz, 1e9 / static_cast<double>(last));
   problems.throw_if_any();
   return plan;
 }

@@ -24,6 +24,10 @@ struct TriggerDevice::Impl {
   std::deque<TriggerEvent> queue;
   bool running = false;  // a run was started and its worker has not finished
   std::uint64_t dropped = 0;
+  // Events dropped and not yet taken by the consumer, so their sets still get the real
+  // trigger time and Δt. Bounded: a consumer that never asks cannot grow it without end.
+  std::deque<TriggerEvent> dropped_untaken;
+  static constexpr std::size_t kMaxDroppedKept = 65536;
   std::exception_ptr error;
   std::jthread worker;
 
@@ -33,6 +37,7 @@ struct TriggerDevice::Impl {
     if (backend->paced()) {
       if (queue.size() >= capacity) {
         ++dropped;
+        if (dropped_untaken.size() < kMaxDroppedKept) dropped_untaken.push_back(event);
         return true;
       }
     } else if (!changed.wait(lock, stop, [&] { return queue.size() < capacity; })) {
@@ -122,6 +127,7 @@ void TriggerDevice::start(std::optional<std::uint64_t> events) {
   if (impl_->worker.joinable()) impl_->worker.join();  // the previous run has finished
   impl_->queue.clear();
   impl_->dropped = 0;
+  impl_->dropped_untaken.clear();
   impl_->error = nullptr;
   impl_->running = true;
   impl_->worker = std::jthread([impl = impl_.get(), events](std::stop_token stop) { impl->run(stop, events); });
@@ -146,5 +152,19 @@ std::uint64_t TriggerDevice::dropped_events() const {
   std::lock_guard lock(impl_->mutex);
   return impl_->dropped;
 }
+
+std::vector<TriggerEvent> TriggerDevice::take_dropped_events() {
+  std::lock_guard lock(impl_->mutex);
+  std::vector<TriggerEvent> out(impl_->dropped_untaken.begin(), impl_->dropped_untaken.end());
+  impl_->dropped_untaken.clear();
+  return out;
+}
+
+std::size_t TriggerDevice::queued_events() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->queue.size();
+}
+
+std::size_t TriggerDevice::queue_capacity() const { return impl_->capacity; }
 
 }  // namespace tomorig::trigger

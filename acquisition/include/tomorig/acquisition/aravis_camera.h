@@ -6,6 +6,7 @@
 //   AravisCamera cam("cam0", opt);
 //   cam.configure(rig.cameras[0]);     // opens config.device_id, applies the features
 //   cam.start([&](CameraFrame&& f) { assembler.add_frame(0, std::move(f)); });
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -17,26 +18,34 @@
 
 namespace tomorig::acquisition {
 
-// How the camera produces the two frames of a set. Either way frames alternate A, B, A, B...
-// so frame k of the stream belongs to set k / 2.
-enum class DoubleFrameMode : std::uint8_t {
-  double_frame,  // the camera takes two frames per trigger (PIV double-shutter cameras)
-  two_triggers,  // the camera takes one frame per trigger and is triggered twice per set
-};
-
 struct AravisCameraOptions {
   // GenICam settings applied by configure(), before the [cameras.features] of the
   // configuration (which may override any of them). Empty strings leave the camera's value.
   std::string acquisition_mode = "Continuous";
-  std::string trigger_mode = "On";          // FrameStart trigger; "Off": free running
-  std::string trigger_source = "Line1";     // "Software" for software triggers
-  std::optional<double> exposure_time_us;   // ExposureTime (or ExposureTimeAbs)
+  // How the camera makes frames A and B (frames alternate A, B, A, B..., so frame k of the
+  // stream belongs to set k / 2):
+  //  hardware:     one trigger, two frames. Written as TriggerSelector = FrameBurstStart with
+  //                AcquisitionBurstFrameCount = 2 (SFNC); a camera without them is refused
+  //                unless [cameras.features] sets TriggerSelector (a vendor double-shutter mode).
+  //  two_triggers: TriggerSelector = FrameStart, one frame per trigger, two triggers a set.
+  //  free_run:     TriggerMode = Off; frames are not tied to trigger events.
+  config::FrameMode frame_mode = config::FrameMode::hardware;
+  std::string trigger_source = "Line1";       // "Software" for software triggers
+  std::string trigger_activation = "RisingEdge";  // the plan's edges; not written for Software
+  std::optional<double> exposure_time_us;     // ExposureTime (or ExposureTimeAbs), read back
+  // A trigger the camera took whose frame has not begun to arrive this long after marks the
+  // camera disconnected (the camera, its cable or its stream is gone), as does the Aravis
+  // "control-lost" signal and a trigger command that fails.
+  std::chrono::milliseconds frame_timeout{400};
+  // Software triggers: frames are matched to the trigger (and event) they answer by time
+  // (TriggerMatcher) within this tolerance, below half the closest spacing of two triggers;
+  // 0: frames are counted instead (frame k of the stream is set k / 2 since start).
+  std::int64_t match_tolerance_ns = 0;
   int packet_size = 0;                      // GigE GevSCPSPacketSize in bytes; 0: camera's value
   int socket_buffer_bytes = 0;              // GigE receive socket buffer; 0: Aravis default
   // GigE: how long an incomplete frame waits for missing packets before it fails (Aravis
   // "frame-retention"); 0: Aravis default. Shorter reports losses sooner.
   int frame_retention_us = 0;
-  DoubleFrameMode mode = DoubleFrameMode::double_frame;
   int buffer_count = 16;                    // frames in the buffer pool (>= 2)
   // Counter of the camera's frame ids: GigE Vision 1.x sends 16-bit ids that skip 0.
   int frame_id_bits = 16;
@@ -58,19 +67,35 @@ class AravisCamera final : public Camera {
 
   const std::string& id() const override;
   // Opens config.device_id (an Aravis device id, serial-based id or IP address) and applies
-  // PixelFormat, the ROI (Width, Height, OffsetX, OffsetY), AcquisitionMode, TriggerMode,
-  // TriggerSource, ExposureTime, packet size and then every [cameras.features] entry.
+  // PixelFormat, the ROI (Width, Height, OffsetX, OffsetY), AcquisitionMode, the frame mode
+  // (TriggerSelector, TriggerMode, TriggerSource, TriggerActivation), ExposureTime, packet
+  // size and then every [cameras.features] entry; each value is read back.
   // Throws runtime_error naming the camera and listing the devices found when the device is
   // absent; bad_input naming the camera and the GenICam feature when a feature is unknown or
-  // a value is not accepted.
+  // a value is not accepted or comes back changed.
   void configure(const config::CameraConfig& config) override;
   void start(FrameSink sink) override;
   void stop() override;
   StreamStatistics statistics() const override;
+  bool connected() const override;
+  std::string connection_problem() const override;
 
-  // Sends one TriggerSoftware command (for trigger_source = "Software").
+  // Sends one TriggerSoftware command (for trigger_source = "Software") and waits for the
+  // camera's answer. Throws runtime_error (and marks the camera disconnected) if it fails.
   void software_trigger();
-  // Trigger pulses the camera needs per double-frame set: 1 (double_frame) or 2 (two_triggers).
+  // Queues the TriggerSoftware commands of trigger event `event` for the camera's trigger
+  // thread and returns at once, so a camera that stopped answering cannot hold up the others:
+  // one (hardware), or two `spacing_ns` apart from when the first was sent (two_triggers).
+  // With match_tolerance_ns its frames carry `event` as trigger index. nullopt: one warm-up
+  // trigger whose frames are discarded. Ignored once disconnected. Needs start().
+  void request_software_trigger(std::optional<std::uint64_t> event, std::int64_t spacing_ns = 0);
+  // Frames no trigger explained (matching by time), discarded.
+  std::uint64_t frames_unmatched() const;
+  // Tells the camera a hardware trigger line fired for it, so a frame that never comes is
+  // noticed (frame_timeout).
+  void note_hardware_trigger();
+  // Trigger pulses the camera needs per double-frame set: 1 (hardware), 2 (two_triggers),
+  // 0 (free_run).
   int triggers_per_set() const;
 
  private:

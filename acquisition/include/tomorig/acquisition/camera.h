@@ -61,6 +61,8 @@ class Camera {
   // Its frames then go missing in the assembler, where they are counted; the rig decides
   // whether to go on without it. Backends that cannot tell report true.
   virtual bool connected() const { return true; }
+  // Why connected() turned false ("no frame 500 ms after its trigger", ...); empty while connected.
+  virtual std::string connection_problem() const { return {}; }
 };
 
 }  // namespace tomorig::acquisition

@@ -3,8 +3,11 @@
 // is emitted when all 2N frames have arrived, or when its timeout expires (then it is flagged
 // incomplete, its missing frames left empty, and counted). Sets leave in trigger-index order.
 // A frame arriving for a set already emitted is late: counted and dropped, never merged into
-// another set. Thread-safe: cameras call add_frame() from their own threads, one consumer
-// pops. Time comes from an injectable clock so tests drive timeouts without sleeping.
+// another set. A camera's pair whose timestamps disagree with the timing plan (B - A outside
+// the expected separation ± tolerance) came from different trigger events: both frames are
+// dropped and counted, so a set never holds frames of two events. Thread-safe: cameras call
+// add_frame() from their own threads, one consumer pops. Time comes from an injectable clock
+// so tests drive timeouts without sleeping.
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -37,6 +40,22 @@ struct AssemblerOptions {
   std::uint64_t max_index_jump = 4096;
   // Sets held for the consumer before add_frame() waits for it (back-pressure, no drops).
   std::size_t max_queued_sets = 64;
+  // The run's end: trigger indices from here on are not part of it (frames counted as
+  // `frames_beyond_run`, triggers ignored), so a camera's extra frames never make extra sets.
+  std::optional<std::uint64_t> end_trigger_index;
+
+  // Per camera (empty, or one entry per camera id), how its frames are checked and placed.
+  struct CameraPairing {
+    // Frame B's timestamp minus frame A's, on the camera's own clock, must lie within
+    // expected_separation_ns ± tolerance_ns; tolerance_ns 0: not checked.
+    std::int64_t expected_separation_ns = 0;
+    std::int64_t tolerance_ns = 0;
+    // A free-running camera: its frames carry no trigger index; each frame fills the next
+    // empty slot (A, then B) of the oldest pending set announced by add_trigger() before the
+    // frame arrived, and is marked unsynchronised. Frames no set waits for are surplus.
+    bool free_running = false;
+  };
+  std::vector<CameraPairing> pairing;
 
   // Throws bad_input naming the field.
   void validate() const;
@@ -48,6 +67,11 @@ struct CameraLoss {
   std::uint64_t frames_missing = 0;   // empty slots in emitted sets
   std::uint64_t frames_late = 0;      // arrived after their set was emitted (dropped)
   std::uint64_t frames_duplicate = 0; // a second frame for the same slot (dropped)
+  std::uint64_t frames_mismatched = 0;  // dropped because B - A disagreed with the plan
+  std::uint64_t frames_beyond_run = 0;  // for trigger indices past the run's end (dropped)
+  std::uint64_t frames_surplus = 0;     // free-running: frames no set waited for (dropped)
+  bool lost = false;                    // mark_camera_lost(): sets no longer wait for it
+  std::string last_mismatch;            // why the latest mismatched pair was dropped
 };
 
 struct AssemblyStatistics {
@@ -72,12 +96,17 @@ class FrameSetAssembler {
   void expire();
   // Emits every pending set now, complete or not (end of acquisition).
   void flush();
+  // The camera is gone: pending and later sets stop waiting for its frames (they are emitted
+  // as soon as the other cameras' frames are in, flagged incomplete). Thread-safe.
+  void mark_camera_lost(std::size_t camera);
 
   // The next emitted set, if one is ready.
   std::optional<FrameSet> try_pop();
   // Waits up to `wait` (real time) for the next set, expiring timed-out sets meanwhile.
   std::optional<FrameSet> pop(std::chrono::milliseconds wait);
   std::size_t queued() const;
+  // Sets still being assembled (not yet emitted).
+  std::size_t pending() const;
 
   AssemblyStatistics statistics() const;
   const AssemblerOptions& options() const { return options_; }
@@ -86,6 +115,7 @@ class FrameSetAssembler {
   struct Pending {
     FrameSet set;
     std::int64_t deadline_ns = 0;
+    std::int64_t announced_ns = 0;  // clock time of add_trigger(); free-running frames wait for it
     bool trigger_known = false;
     bool frame_timing_known = false;
   };
@@ -94,6 +124,11 @@ class FrameSetAssembler {
   void emit_front_locked(std::unique_lock<std::mutex>& lock);
   Pending& pending_for_locked(std::uint64_t index, std::int64_t now);
   bool accept_index_locked(std::uint64_t index);
+  bool ready_locked(const Pending& p) const;  // every frame the set still waits for is in
+  void place_locked(std::size_t camera, Pending& p, CameraFrame&& frame);
+  void place_free_running_locked(std::size_t camera, CameraFrame&& frame);
+  void check_pairs_locked(FrameSet& set);
+  const AssemblerOptions::CameraPairing* pairing_of(std::size_t camera) const;
 
   AssemblerOptions options_;
   AssemblyClock clock_;

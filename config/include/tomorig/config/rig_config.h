@@ -16,6 +16,13 @@ namespace tomorig::config {
 enum class CameraBackend : std::uint8_t { aravis, simulated };
 enum class TriggerBackend : std::uint8_t { gpio, simulated };
 
+// How a camera makes the two frames of a set (docs/configuration.md, frame_mode).
+enum class FrameMode : std::uint8_t {
+  hardware,      // one trigger, two frames: a PIV double-shutter camera
+  two_triggers,  // a single-frame camera, triggered at pulse 1 and again at pulse 2
+  free_run,      // not triggered: frames are unsynchronised, no set is ever complete
+};
+
 struct Roi {
   int offset_x = 0, offset_y = 0;
   int width = 0, height = 0;  // pixels; 0 x 0: the full sensor (Aravis camera without [cameras.roi])
@@ -29,6 +36,7 @@ struct CameraConfig {
   Roi roi;
   PixelFormat pixel_format = PixelFormat::Mono16;
   double pixel_pitch_um = 7.4;
+  FrameMode frame_mode = FrameMode::hardware;
   // Simulated cameras only: pinhole placement (see simulators/).
   double yaw_deg = 0.0;
   double focal_length_mm = 100.0;
@@ -65,6 +73,13 @@ struct CameraTimingConfig {
   double exposure_a_us = 20.0;    // frame A exposure
   double interframe_us = 0.12;    // blind time between frames A and B
   double exposure_b_us = 1000.0;  // frame B (until frame A is read out)
+  // frame_mode "two_triggers": the least time from the end of one exposure to the next
+  // trigger the camera accepts (sensor readout); 0: not given (required for two_triggers).
+  double readout_us = 0.0;
+  // How far B - A of a camera's frame timestamps may stray from the plan; unset: half the
+  // smaller of the frame separation and the rest of the period for two_triggers, no check
+  // for hardware double-frame cameras (whose timestamps differ by vendor).
+  std::optional<double> frame_time_tolerance_us;
 };
 
 struct TriggerConfig {
@@ -142,5 +157,6 @@ const std::vector<std::string>& simulation_case_names();
 
 std::string_view to_string(CameraBackend b);
 std::string_view to_string(TriggerBackend b);
+std::string_view to_string(FrameMode m);
 
 }  // namespace tomorig::config

@@ -14,6 +14,9 @@ enum class Exposure : std::uint8_t { A = 0, B = 1 };
 struct Frame {
   Image image;                    // empty if the frame was lost
   std::int64_t timestamp_ns = 0;  // camera or trigger clock, ns
+  // false: a free-running camera's frame, taken near the event but not exposed by its
+  // trigger (frame_mode "free_run"); such a frame never makes a set complete.
+  bool synchronised = true;
   bool present() const { return !image.empty(); }
 };
 
@@ -38,7 +41,15 @@ struct FrameSet {
     for (const auto& c : cameras) missing += (c.a.present() ? 0 : 1) + (c.b.present() ? 0 : 1);
     return missing;
   }
-  bool complete() const { return missing_frames() == 0; }
+  // Present frames that were not exposed by this trigger event (free-running cameras).
+  int unsynchronised_frames() const {
+    int n = 0;
+    for (const auto& c : cameras)
+      n += (c.a.present() && !c.a.synchronised ? 1 : 0) + (c.b.present() && !c.b.synchronised ? 1 : 0);
+    return n;
+  }
+  // Every frame present and exposed by this event: a set fit for PIV.
+  bool complete() const { return missing_frames() == 0 && unsynchronised_frames() == 0; }
 };
 
 }  // namespace tomorig

@@ -28,12 +28,17 @@
 #include "tomorig/config/rig_config.h"
 #include "tomorig/storage/session_file.h"
 #include "tomorig/trigger/simulated_device.h"
+#include "tomorig/trigger/timing_plan.h"
 
 namespace tomorig::sim {
 class SimulatedRig;
 }
 namespace tomorig::trigger {
 class TriggerDevice;
+struct TriggerEvent;
+}
+namespace tomorig::acquisition {
+class AravisCamera;
 }
 
 namespace tomorig::rig {
@@ -62,6 +67,8 @@ void add_camera_fault(std::map<std::string, acquisition::SimulatedCameraFaults>&
 struct CameraHealth {
   std::string id;
   bool connected = true;
+  std::string problem;        // why it is not connected
+  bool free_running = false;  // frame_mode "free_run": its sets are never complete
   acquisition::StreamStatistics stream;
 };
 
@@ -69,6 +76,11 @@ struct CameraHealth {
 struct RigProgress {
   std::uint64_t trigger_events = 0;          // events the acquisition loop handled
   std::uint64_t dropped_trigger_events = 0;  // events a paced device fired while the loop lagged
+  // Events fired and not yet handled: the loop's lag behind the trigger. A paced device drops
+  // events once this reaches trigger_queue_capacity.
+  std::size_t trigger_queue = 0;
+  std::size_t trigger_queue_capacity = 0;
+  double rate_hz = 0.0;                      // the trigger's event rate (lag in time = queue / rate)
   std::size_t queued_sets = 0;               // sets assembled and not yet popped
   acquisition::AssemblyStatistics assembly;
   std::vector<CameraHealth> cameras;
@@ -112,9 +124,13 @@ class RigAcquisition {
  private:
   void loop();
   void handle_event(std::uint64_t index, std::int64_t timestamp_ns, std::int64_t dt_ns);
+  void trigger_aravis_cameras(std::uint64_t index, std::int64_t dt_ns);
+  void announce_dropped_events(std::optional<std::uint64_t> before);
   void check_cameras(std::uint64_t index);
+  void report_mismatches();
   void finish_run();
   void notice(std::string text);
+  void warm_up_cameras();
 
   config::RigConfig rig_;
   RigAcquisitionOptions options_;
@@ -125,8 +141,16 @@ class RigAcquisition {
   std::unique_ptr<acquisition::FrameSetAssembler> assembler_;
   std::vector<std::unique_ptr<acquisition::Camera>> cameras_;
   std::vector<acquisition::SimulatedCamera*> simulated_cameras_;  // views into cameras_
+  std::vector<acquisition::AravisCamera*> aravis_cameras_;        // views into cameras_
+  std::vector<bool> free_running_;  // by camera: frame_mode "free_run"
   bool software_triggers_ = false;  // Aravis cameras triggered by the loop
+  trigger::TimingPlan plan_;
   std::vector<bool> reported_lost_;
+  std::vector<std::uint64_t> reported_mismatches_;
+  // Dropped trigger events not yet announced to the assembler, oldest first.
+  std::vector<trigger::TriggerEvent> dropped_;
+
+
 
   // The frames the simulator rendered for the event being handled, by camera id; the simulated
   // cameras' renderers take them from here (same thread).

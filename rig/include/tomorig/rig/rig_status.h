@@ -1,9 +1,12 @@
 #pragma once
 // The live status of a running rig (tomorig run, tomorig acquire): one line on stderr,
 // rewritten in place on a terminal, and the same figures as JSON on the status PUB socket
-// (docs/wire-protocol.md, "Status messages").
+// (docs/wire-protocol.md, "Status messages"; docs/acquisition.md lists the fields).
 //
 //   recording: set 12/500  9.9 sets/s  41.9 MB/s  queue 1  lost frames/incomplete sets: cam0 0/0 cam1 2/1
+//     trigger: lag 0 events (0 ms) of 256, dropped 0  disk: 812.4 GB free, 331 min to full
+//     cameras: cam0 connected 24 frames, underruns 0, failed 0, missing packets 0, resends 0, mismatched 0; ...
+//     WARNING ...
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -18,6 +21,7 @@ class context_t;
 }
 namespace tomorig::stream {
 class StatusPublisher;
+struct Status;
 }
 
 namespace tomorig::rig {
@@ -36,7 +40,7 @@ class LossTally {
   // loses both frames).
   void add(const FrameSet& set);
   std::uint64_t frames_lost() const;
-  std::uint64_t incomplete_sets() const { return incomplete_sets_; }  // sets missing any frame
+  std::uint64_t incomplete_sets() const { return incomplete_sets_; }  // sets missing a frame or unsynchronised
   const std::vector<Camera>& cameras() const { return cameras_; }
   // "cam0 0/0 cam1 2/1" (lost frames / incomplete sets)
   std::string per_camera() const;
@@ -46,6 +50,19 @@ class LossTally {
   std::uint64_t incomplete_sets_ = 0;
 };
 
+struct RigProgress;
+
+// One camera as the status shows it (the losses its sets show come from LossTally).
+struct CameraFigures {
+  std::string id;
+  bool connected = true;
+  std::string problem;        // why not connected
+  bool free_running = false;
+  std::uint64_t frames = 0;   // delivered by the camera
+  std::uint64_t underruns = 0, failed = 0, missing_packets = 0, resends = 0;  // Aravis stream counters
+  std::uint64_t mismatched = 0;  // frames dropped because B - A disagreed with the plan
+};
+
 struct StatusFigures {
   std::string state = "running";     // running, stopping, stopped, failed
   std::uint64_t sets = 0;             // sets done (recorded, or sent)
@@ -53,8 +70,24 @@ struct StatusFigures {
   std::uint64_t bytes = 0;            // pixel bytes done
   std::uint64_t queue_depth = 0;      // sets between acquisition and the recorder
   std::uint64_t dropped_trigger_events = 0;
+  std::uint64_t trigger_lag_events = 0;      // events fired and not yet handled
+  std::uint64_t trigger_queue_capacity = 0;  // a paced trigger drops events beyond this lag
+  double trigger_rate_hz = 0.0;
+  std::optional<std::uint64_t> disk_free_bytes;  // where the recording goes (to_disk only)
   bool to_disk = true;                // bytes went to disk (run, record) or to the stream (acquire)
+  std::vector<CameraFigures> cameras;
 };
+
+// Copies the rig's snapshot (trigger lag and drops, camera health and stream counters) into
+// the figures.
+void take_progress(StatusFigures& figures, const RigProgress& progress);
+
+// Sets between two counters that are read one after the other while both move: the receiver
+// may already count a set the sender's counter does not show yet. Never below zero.
+std::uint64_t sets_in_flight(std::uint64_t sent, std::uint64_t received);
+
+// A trigger lag this deep (of the queue's capacity) is warned about before events drop.
+inline constexpr double kLagWarningFraction = 0.25;
 
 class StatusReporter {
  public:
@@ -76,6 +109,13 @@ class StatusReporter {
   // Ends a status line rewritten in place, so other messages start on a fresh line.
   void break_line();
 
+  // The status as text (the line) and as the JSON status message: the same figures.
+  std::string line(const StatusFigures& figures, const LossTally& losses, double minutes_until_full) const;
+  stream::Status message(const StatusFigures& figures, const LossTally& losses, double minutes_until_full) const;
+  // What needs the operator: a lost camera, free-running cameras, a lagging trigger, a disk
+  // about to fill. On every status line while it lasts.
+  static std::vector<std::string> warnings(const StatusFigures& figures, double minutes_until_full);
+
  private:
   std::string label_;
   bool tty_;
@@ -89,6 +129,7 @@ class StatusReporter {
   double mb_per_second_ = 0.0;
   bool line_open_ = false;
   std::uint64_t printed_sets_ = ~std::uint64_t{0};  // sets shown by the last line
+  std::string printed_health_;                      // cameras' connected flags on the last line
 };
 
 }  // namespace tomorig::rig

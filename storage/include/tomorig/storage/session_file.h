@@ -75,6 +75,8 @@ struct SetRecord {
   // One entry per camera, in session order; [0] is exposure A, [1] exposure B.
   std::vector<std::array<std::int64_t, 2>> frame_timestamp_ns;
   std::vector<std::array<bool, 2>> frame_present;
+  // false: a free-running camera's frame (frame_present = 2 in the file), not of this event.
+  std::vector<std::array<bool, 2>> frame_synchronised;
 };
 
 // SessionInfo::software_version and created_utc are filled in by the writer when empty;

@@ -23,6 +23,15 @@ struct CameraStatus {
   std::string camera_id;
   std::uint64_t frames_lost = 0;
   std::uint64_t incomplete_sets = 0;
+  bool connected = true;
+  std::string problem;              // why it is not connected; empty while it is
+  bool free_running = false;        // frame_mode "free_run": unsynchronised, sets never complete
+  std::uint64_t frames = 0;         // frames the camera delivered
+  std::uint64_t underruns = 0;      // Aravis stream: frames dropped for want of a buffer
+  std::uint64_t failed = 0;         // Aravis stream: incomplete or unusable frames
+  std::uint64_t missing_packets = 0;  // GigE Vision packets never received
+  std::uint64_t resends = 0;          // GigE Vision packets received after a resend request
+  std::uint64_t mismatched = 0;       // frames dropped because B - A disagreed with the plan
 
   bool operator==(const CameraStatus&) const = default;
 };
@@ -38,6 +47,13 @@ struct Status {
   std::uint64_t preview_drops = 0;
   std::uint64_t queue_depth = 0;    // sets waiting between acquisition and recorder
   double disk_mb_per_second = 0.0;
+  std::uint64_t dropped_trigger_events = 0;  // events the trigger fired while the rig lagged
+  std::uint64_t trigger_lag_events = 0;      // events fired and not yet handled
+  double trigger_lag_ms = 0.0;               // the same as time: events / rate
+  std::uint64_t trigger_queue_capacity = 0;  // events are dropped once the lag reaches this
+  std::int64_t disk_free_bytes = -1;         // -1: not recording to disk
+  double disk_minutes_until_full = -1.0;     // at the current write rate; -1: unknown
+  std::vector<std::string> warnings;         // what the operator must look at, as on the status line
   std::vector<CameraStatus> cameras;
 
   bool operator==(const Status&) const = default;

@@ -3,8 +3,10 @@
 // lies, given the rate, the pulse separation, the light sources, the camera and the wiring.
 //
 // Time model (docs/trigger.md has the diagram): a double-frame camera, triggered once, exposes
-// frame A, is blind for the interframe time, then exposes frame B. Light pulse 1 must lie inside
-// frame A and pulse 2 inside frame B, with dt between the pulse centres. Each output channel
+// frame A, is blind for the interframe time, then exposes frame B. A single-frame camera
+// (FrameMode::two_triggers) is triggered twice, once per frame, and needs its readout time
+// between the end of frame A and the second trigger. Light pulse 1 must lie inside frame A and
+// pulse 2 inside frame B, with dt between the pulse centres. Each output channel
 // fires its electrical edge early by its own delay (camera trigger latency, LED driver rise
 // time, Q-switch build-up) so that the optical event lands where planned. All times are integer
 // nanoseconds; the period starts (t = 0) at the earliest edge of any channel.
@@ -23,6 +25,13 @@ enum class ChannelRole : std::uint8_t {
   flashlamp,        // a laser head's flash lamp, fired `flashlamp_lead_ns` before its Q-switch
   pulse_generator,  // trigger input of an external delay generator that makes the µs pulses
 };
+
+// How the triggered cameras make frames A and B.
+enum class FrameMode : std::uint8_t {
+  hardware,      // one trigger; the camera exposes A, waits the interframe time, exposes B
+  two_triggers,  // one trigger per frame; frame B needs the readout time after frame A
+};
+std::string_view to_string(FrameMode mode);
 
 // Which of the two straddled pulses a light (or flash-lamp) channel makes: one head of a
 // dual-cavity laser makes one, an LED makes both.
@@ -57,9 +66,12 @@ struct ChannelSpec {
 
 // The camera's double-frame timing (identical cameras; per-camera latency is ChannelSpec::delay_ns).
 struct CameraTiming {
-  std::int64_t exposure_a_ns = 20'000;    // frame A exposure, set on the camera
-  std::int64_t interframe_ns = 120;       // blind time between frames A and B (sCMOS: ~120 ns)
-  std::int64_t exposure_b_ns = 1'000'000; // frame B: lasts until frame A is read out
+  std::int64_t exposure_a_ns = 20'000;    // frame A exposure, set on the camera (two_triggers: both frames)
+  std::int64_t interframe_ns = 120;       // hardware: blind time between frames A and B (sCMOS: ~120 ns)
+  std::int64_t exposure_b_ns = 1'000'000; // hardware: frame B lasts until frame A is read out
+  std::int64_t readout_ns = 0;            // two_triggers: least time from the end of an exposure
+                                          // to the next trigger the camera takes (> 0)
+  FrameMode mode = FrameMode::hardware;
 };
 
 struct TimingInputs {
@@ -98,6 +110,10 @@ struct TimingPlan {
   std::int64_t straddle_margin_ns = 0;
   std::vector<LightSource> light_sources;
   std::vector<ChannelTiming> channels;
+
+  // Where B - A of a camera's own frame timestamps should come out: the start of frame B
+  // after the start of frame A (two_triggers: dt; hardware: exposure A + interframe).
+  std::int64_t frame_separation_ns() const { return frame_b.rise_ns - frame_a.rise_ns; }
 
   const ChannelTiming* find_channel(std::string_view name) const;
   const LightSource* find_light_source(std::string_view name) const;

@@ -70,6 +70,13 @@ class TriggerDevice {
 
   // Events a paced device fired while the queue was full (the consumer lagged).
   std::uint64_t dropped_events() const;
+  // Those events themselves (index, time, Δt), each returned once, oldest first; a consumer
+  // that never calls this keeps at most 65536 of them.
+  std::vector<TriggerEvent> take_dropped_events();
+  // Events fired and waiting for the consumer; a paced device drops once this reaches
+  // queue_capacity(), so it is the consumer's lag behind the trigger.
+  std::size_t queued_events() const;
+  std::size_t queue_capacity() const;
 
  private:
   struct Impl;

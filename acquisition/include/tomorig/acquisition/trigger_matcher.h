@@ -1,0 +1,66 @@
+#pragma once
+// Which trigger a software-triggered camera's frame answers, found by time. A camera numbers
+// its frames, not trigger events: one trigger it missed (a camera not yet ready after
+// AcquisitionStart, a command lost) would shift every later frame into the wrong set if
+// frames were simply counted. The matcher knows when each trigger was sent (host clock) and
+// learns the offset from the host's clock to the camera's from the frames it matched (the
+// median of the last 16, per frame A and B triggers, so one late frame moves nothing): a frame answers the trigger whose
+// time plus that offset is nearest its timestamp. Triggers passed over are counted as lost; a
+// frame near no trigger answers none. The camera's clock never has to agree with the host's,
+// only run at the same rate.
+//
+//   TriggerMatcher m(2, 20'000'000);                  // hardware: two frames per trigger
+//   m.expect({event, host_ns});                       // before sending each trigger
+//   if (auto hit = m.match(frame.frame_id, frame.timestamp_ns)) frame.trigger_index = *hit->event;
+#include <cstdint>
+#include <deque>
+#include <vector>
+#include <mutex>
+#include <optional>
+
+#include "tomorig/core/frame_set.h"
+
+namespace tomorig::acquisition {
+
+class TriggerMatcher {
+ public:
+  struct Trigger {
+    std::optional<std::uint64_t> event;  // nullopt: a warm-up trigger whose frame is discarded
+    Exposure exposure = Exposure::A;     // the frame it starts (two_triggers: A or B)
+    std::int64_t host_ns = 0;            // when it was sent, host steady clock
+  };
+  struct Match {
+    std::optional<std::uint64_t> event;
+    Exposure exposure = Exposure::A;
+  };
+
+  // frames_per_trigger: 1 (two_triggers) or 2 (hardware: frame B follows frame A by id).
+  // tolerance_ns: how far a frame's timestamp may be from where the trigger spacing puts it;
+  // below half the closest spacing of two triggers. Throws bad_input otherwise out of range.
+  TriggerMatcher(int frames_per_trigger, std::int64_t tolerance_ns);
+
+  void expect(const Trigger& trigger);  // in the order the triggers are sent; thread-safe
+  // The trigger `frame_id` (unwrapped frame counter) with camera timestamp `timestamp_ns`
+  // answers, or nullopt (no trigger near it: the frame belongs to no set). Thread-safe.
+  std::optional<Match> match(std::uint64_t frame_id, std::int64_t timestamp_ns);
+
+  std::uint64_t triggers_lost() const;   // passed over: their frames never came
+  std::uint64_t frames_unmatched() const;
+
+ private:
+  int frames_per_trigger_;
+  std::int64_t tolerance_ns_;
+  mutable std::mutex mutex_;
+  std::deque<Trigger> pending_;
+  // Camera timestamp - trigger time of recent matches, for triggers of frame A and of frame B
+  // apart: a camera may answer one systematically later (Aravis's fake, whose 40 ms trigger
+  // grid falls 20 ms later for a trigger sent 60 ms after the first).
+  std::deque<std::int64_t> offsets_[2];
+  int misses_in_a_row_ = 0;
+  std::optional<Trigger> open_pair_;   // frames_per_trigger 2: the trigger whose frame B is next
+  std::uint64_t open_pair_frame_id_ = 0;
+  std::uint64_t lost_ = 0;
+  std::uint64_t unmatched_ = 0;
+};
+
+}  // namespace tomorig::acquisition

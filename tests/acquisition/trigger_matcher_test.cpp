@@ -1,0 +1,101 @@
+// Frames of software-triggered cameras matched to their triggers by time: a trigger the camera
+// missed shifts no later frame into another set, and a frame near no trigger joins none.
+#include "tomorig/acquisition/trigger_matcher.h"
+
+#include <gtest/gtest.h>
+
+#include "tomorig/core/error.h"
+
+namespace tomorig::acquisition {
+namespace {
+
+constexpr std::int64_t kMs = 1'000'000;
+constexpr std::int64_t kCameraClock = 987'654 * kMs;  // the camera's clock: any origin
+
+// Two triggers a set at 5 Hz, 60 ms apart: event k's triggers at 200k and 200k + 60 ms.
+void expect_events(TriggerMatcher& m, std::uint64_t events) {
+  for (std::uint64_t k = 0; k < events; ++k) {
+    const auto t = static_cast<std::int64_t>(k) * 200 * kMs;
+    m.expect({k, Exposure::A, t});
+    m.expect({k, Exposure::B, t + 60 * kMs});
+  }
+}
+
+TEST(TriggerMatcher, FramesAnswerTheirOwnTriggersDespiteLatencyJitter) {
+  TriggerMatcher m(1, 30 * kMs);
+  expect_events(m, 4);
+  // The camera answers 0-40 ms late (Aravis's GigE fake: its 40 ms trigger grid shifts
+  // consecutive latencies by 20 ms at most here), on its own clock.
+  const std::int64_t latency[8] = {5, 25, 30, 10, 0, 20, 12, 31};
+  for (std::uint64_t k = 0; k < 4; ++k)
+    for (int e = 0; e < 2; ++e) {
+      const std::int64_t t = static_cast<std::int64_t>(k) * 200 * kMs + e * 60 * kMs + latency[2 * k + e] * kMs;
+      const auto hit = m.match(2 * k + e, kCameraClock + t);
+      ASSERT_TRUE(hit) << "event " << k;
+      EXPECT_EQ(hit->event, k);
+      EXPECT_EQ(hit->exposure, e == 0 ? Exposure::A : Exposure::B);
+    }
+  EXPECT_EQ(m.triggers_lost(), 0u);
+}
+
+TEST(TriggerMatcher, ATriggerTheCameraMissedShiftsNothing) {
+  TriggerMatcher m(1, 30 * kMs);
+  expect_events(m, 3);
+  // Frame B of event 0 never came (the trigger was lost); counting frames would pair event
+  // 1's A with event 0's A and shift every later frame.
+  ASSERT_EQ(m.match(0, kCameraClock + 10 * kMs)->event, 0u);
+  const auto a1 = m.match(1, kCameraClock + 210 * kMs);
+  ASSERT_TRUE(a1);
+  EXPECT_EQ(a1->event, 1u);
+  EXPECT_EQ(a1->exposure, Exposure::A);
+  const auto b1 = m.match(2, kCameraClock + 270 * kMs);
+  ASSERT_TRUE(b1);
+  EXPECT_EQ(b1->event, 1u);
+  EXPECT_EQ(b1->exposure, Exposure::B);
+  EXPECT_EQ(m.triggers_lost(), 1u);
+}
+
+TEST(TriggerMatcher, AWarmUpFrameAnswersNoEventAndAStrayFrameNone) {
+  TriggerMatcher m(1, 30 * kMs);
+  m.expect({std::nullopt, Exposure::A, -500 * kMs});  // warm-up, its frame 90 ms late
+  expect_events(m, 1);
+  const auto warm = m.match(0, kCameraClock - 410 * kMs);
+  ASSERT_TRUE(warm);
+  EXPECT_FALSE(warm->event);
+
+  // The warm-up's 90 ms answer (a camera not ready yet) teaches nothing: event 0's trigger,
+  // answered in 10 ms, is still the one its frame answers.
+  EXPECT_EQ(m.match(2, kCameraClock + 10 * kMs)->event, 0u);
+}
+
+TEST(TriggerMatcher, AFrameNearNoTriggerJoinsNoSet) {
+  TriggerMatcher m(1, 30 * kMs);
+  expect_events(m, 2);
+  ASSERT_EQ(m.match(0, kCameraClock + 10 * kMs)->event, 0u);
+  EXPECT_FALSE(m.match(1, kCameraClock + 130 * kMs)) << "a frame between triggers joined a set";
+  EXPECT_EQ(m.frames_unmatched(), 1u);
+  EXPECT_EQ(m.match(2, kCameraClock + 75 * kMs)->exposure, Exposure::B);
+}
+
+TEST(TriggerMatcher, DoubleFrameCamerasGiveFrameBRightAfterFrameA) {
+  TriggerMatcher m(2, 100 * kMs);
+  for (std::uint64_t k = 0; k < 3; ++k) m.expect({k, Exposure::A, static_cast<std::int64_t>(k) * 200 * kMs});
+  EXPECT_EQ(m.match(10, kCameraClock)->exposure, Exposure::A);
+  const auto b0 = m.match(11, kCameraClock + 20'120);
+  EXPECT_EQ(b0->event, 0u);
+  EXPECT_EQ(b0->exposure, Exposure::B);
+  // Event 1's trigger was missed: both of its frames are absent, event 2's come next.
+  const auto a2 = m.match(12, kCameraClock + 400 * kMs);
+  EXPECT_EQ(a2->event, 2u);
+  EXPECT_EQ(a2->exposure, Exposure::A);
+  EXPECT_EQ(m.match(13, kCameraClock + 400 * kMs + 20'120)->exposure, Exposure::B);
+  EXPECT_EQ(m.triggers_lost(), 1u);
+}
+
+TEST(TriggerMatcher, OptionsAreChecked) {
+  EXPECT_THROW(TriggerMatcher(3, kMs), Error);
+  EXPECT_THROW(TriggerMatcher(1, 0), Error);
+}
+
+}  // namespace
+}  // namespace tomorig::acquisition
