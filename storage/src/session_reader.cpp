@@ -333,8 +333,10 @@ std::vector<T> SessionReader::Impl::read_set_dataset(hid_t group, const char* na
     if (H5Tget_class(type.get()) != H5T_INTEGER)
       invalid(fmt::format("{} holds {}; integers are expected", where,
                           H5Tget_class(type.get()) == H5T_FLOAT ? "floating-point numbers" : "non-integers"));
+    // The sets that count, not the extent: an interrupted live recording may have grown a
+    // dataset for a set it never wrote.
     std::optional<std::uint64_t> stored_bytes = H5Tget_size(type.get());
-    for (hsize_t d : dims) stored_bytes = stored_bytes ? checked_product(*stored_bytes, d) : std::nullopt;
+    for (hsize_t d : expected) stored_bytes = stored_bytes ? checked_product(*stored_bytes, d) : std::nullopt;
     require_stored(dataset.get(), stored_bytes, where);
   }
   std::optional<std::uint64_t> count = 1;

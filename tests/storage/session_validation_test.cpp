@@ -97,6 +97,22 @@ class Edit {
     H5Sclose(space);
     H5Dclose(ds);
   }
+  // Replaces a /sets dataset by a deflate-compressed one of `rows` records (of `record` elements
+  // of `type`, zeros), as another tool might write it; compressed data says nothing about its size.
+  void replace_with_compressed(const char* dataset, hid_t type, std::vector<hsize_t> record, hsize_t rows) {
+    H5Ldelete(file_, dataset, H5P_DEFAULT);
+    std::vector<hsize_t> dims{rows}, max{H5S_UNLIMITED}, chunk{512};
+    for (hsize_t r : record) dims.push_back(r), max.push_back(r), chunk.push_back(r);
+    const hid_t space = H5Screate_simple(static_cast<int>(dims.size()), dims.data(), max.data());
+    const hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+    H5Pset_chunk(dcpl, static_cast<int>(chunk.size()), chunk.data());
+    H5Pset_deflate(dcpl, 6);
+    const hid_t ds = H5Dcreate2(file_, dataset, type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    EXPECT_GE(ds, 0) << dataset;
+    H5Dclose(ds);
+    H5Pclose(dcpl);
+    H5Sclose(space);
+  }
   hid_t id() const { return file_; }
 
  private:
@@ -207,6 +223,26 @@ TEST(SessionValidation, DeclaredSetCountBeyondWhatTheFileStoresIsRefused) {
   ASSERT_LT(fs::file_size(path), 1u << 20);
   expect_error([&] { SessionReader r(path); }, ErrorKind::bad_input,
                {path.string(), "corrupt", "declares", "bytes of data but the file stores"});
+}
+
+// The same with compressed records (another tool's file): the stored size proves nothing, so the
+// memory the records would take is bounded by the file's size (16 times, at least 64 MiB).
+TEST(SessionValidation, DeclaredSetCountOfCompressedRecordsIsBoundedByTheFileSize) {
+  TempDir dir;
+  const fs::path path = four_camera_session(dir);
+  {
+    Edit edit(path);
+    const hsize_t billion = 1'000'000'000;
+    for (const char* c : {"/cameras/cam0/frames", "/cameras/cam1/frames", "/cameras/cam2/frames", "/cameras/cam3/frames"})
+      edit.declare_first_dim(c, billion);
+    edit.replace_with_compressed("/sets/trigger_index", H5T_STD_U64LE, {}, billion);
+    edit.replace_with_compressed("/sets/trigger_timestamp_ns", H5T_STD_I64LE, {}, billion);
+    edit.replace_with_compressed("/sets/dt_ns", H5T_STD_I64LE, {}, billion);
+    edit.replace_with_compressed("/sets/frame_timestamp_ns", H5T_STD_I64LE, {4, 2}, billion);
+    edit.replace_with_compressed("/sets/frame_present", H5T_STD_U8LE, {4, 2}, billion);
+  }
+  expect_error([&] { SessionReader r(path); }, ErrorKind::bad_input,
+               {path.string(), "/sets/trigger_index would take 8000000000 bytes of memory", "declared size is damaged"});
 }
 
 // Defect 6: declared 65536 x 65536 frames drove `replay` to 8 GB; a frame is one HDF5 chunk
