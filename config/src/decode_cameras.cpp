@@ -10,9 +10,14 @@
 #include <fmt/format.h>
 
 #include "decode.h"
+#include "tomorig/core/camera_id.h"
 
 namespace tomorig::config::detail {
 namespace {
+
+// Image sides and offsets: as the wire format allows (stream/wire_format.h), so that a ROI that
+// passes here can be sent, recorded and allocated.
+constexpr int kMaxImageSidePx = 1 << 16;
 
 constexpr Choice<CameraBackend> kCameraBackends[] = {
     {"aravis", CameraBackend::aravis}, {"simulated", CameraBackend::simulated}};
@@ -32,10 +37,10 @@ void decode_roi(TableReader& cam, bool simulated, Roi& roi) {
   }
   auto r = cam.table("roi");
   if (!r) return;
-  r->read("offset_x", roi.offset_x, Need::optional, at_least(0));
-  r->read("offset_y", roi.offset_y, Need::optional, at_least(0));
-  r->read("width", roi.width, Need::required, greater_than(0));
-  r->read("height", roi.height, Need::required, greater_than(0));
+  r->read("offset_x", roi.offset_x, Need::optional, and_at_most(at_least(0), kMaxImageSidePx));
+  r->read("offset_y", roi.offset_y, Need::optional, and_at_most(at_least(0), kMaxImageSidePx));
+  r->read("width", roi.width, Need::required, and_at_most(greater_than(0), kMaxImageSidePx));
+  r->read("height", roi.height, Need::required, and_at_most(greater_than(0), kMaxImageSidePx));
   r->report_unknown_keys();
 }
 
@@ -132,6 +137,13 @@ void decode_cameras(TableReader& root, const TriggerConfig& trigger, std::vector
   for (auto& r : root.array_of_tables("cameras", Need::required)) {
     CameraConfig cam;
     decode_camera(r, trigger, cam);
+    // One rule for ids everywhere (core/camera_id.h); the value is shown escaped, never raw.
+    if (const auto problem = cam.id.empty() ? std::nullopt : camera_id_problem(cam.id)) {
+      r.issue("id", fmt::format("\"{}\" is not allowed: it {} (camera ids name folders in session files: 1 to {} "
+                                "bytes of UTF-8 without '/', control characters, '.' or '..')",
+                                printable(cam.id), *problem, kMaxCameraIdBytes));
+      cam.id.clear();
+    }
     if (cam.frame_mode != FrameMode::free_run) {
       if (!triggered_mode) {
         triggered_mode.emplace(cam.frame_mode, r.path());

@@ -35,7 +35,7 @@ void decode_light_source(TableReader& r, const TriggerConfig& t, bool dt_ok, Lig
   if (width_ok && dt_ok && s.pulse_width_us >= t.dt_us)
     r.issue("pulse_width_us", fmt::format("{} must be < trigger.dt_us ({})", s.pulse_width_us, t.dt_us));
 
-  if (r.read("flashlamp_lead_us", s.flashlamp_lead_us, Need::optional, at_least(0.0)) && s.kind != "laser") {
+  if (r.read("flashlamp_lead_us", s.flashlamp_lead_us, Need::optional, non_negative_time_us()) && s.kind != "laser") {
     r.issue("flashlamp_lead_us",
             fmt::format("only lasers have a flash lamp, but this source is {}: set kind = \"laser\" or remove the key",
                         s.kind.empty() ? std::string("of no stated kind") : fmt::format("kind = \"{}\"", s.kind)));

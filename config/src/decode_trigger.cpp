@@ -20,7 +20,7 @@ void decode_camera_timing(TableReader& trigger, CameraTimingConfig& camera) {
   auto r = trigger.table("camera");
   if (!r) return;
   r->read("exposure_a_us", camera.exposure_a_us, Need::optional, positive_duration_us());
-  r->read("interframe_us", camera.interframe_us, Need::optional, at_least(0.0));
+  r->read("interframe_us", camera.interframe_us, Need::optional, non_negative_time_us());
   r->read("exposure_b_us", camera.exposure_b_us, Need::optional, positive_duration_us());
   r->read("readout_us", camera.readout_us, Need::optional, positive_duration_us());
   double tolerance = 0.0;
@@ -37,14 +37,22 @@ void decode_trigger(TableReader& root, TriggerConfig& t) {
   const bool backend_known = r->read_choice("backend", backend, kTriggerBackends, Need::required);
   if (backend_known) t.backend = backend;
 
-  const bool rate_ok = valid_or_absent(*r, "rate_hz", r->read("rate_hz", t.rate_hz, Need::optional, greater_than(0.0)));
-  const bool dt_ok = valid_or_absent(*r, "dt_us", r->read("dt_us", t.dt_us, Need::optional, greater_than(0.0)));
-  const bool width_ok =
-      valid_or_absent(*r, "pulse_width_us", r->read("pulse_width_us", t.pulse_width_us, Need::optional, greater_than(0.0)));
-  r->read("jitter_ns", t.jitter_ns, Need::optional, at_least(0.0));
+  const Rule<double> rate_rule{[](const double& v) -> std::optional<std::string> {
+    if (!(v > 0.0)) return std::string("must be > 0");
+    if (v >= kMinRateHz && v <= kMaxRateHz) return std::nullopt;
+    return fmt::format("must be in [{:g}, {:g}] (a trigger period of 1 us to 1000 s)", kMinRateHz, kMaxRateHz);
+  }};
+  const bool rate_ok = valid_or_absent(*r, "rate_hz", r->read("rate_hz", t.rate_hz, Need::optional, rate_rule));
+  const bool dt_ok =
+      valid_or_absent(*r, "dt_us", r->read("dt_us", t.dt_us, Need::optional, bounded_time_us(greater_than(0.0))));
+  const bool width_ok = valid_or_absent(
+      *r, "pulse_width_us", r->read("pulse_width_us", t.pulse_width_us, Need::optional, bounded_time_us(greater_than(0.0))));
+  r->read("jitter_ns", t.jitter_ns, Need::optional,
+          and_at_most(at_least(0.0), kMaxDurationUs * 1e3, "1000 s, the longest time a rig file may give"));
   r->read("gpio_resolution_us", t.gpio_resolution_us, Need::optional,
           Rule<double>{[](const double& v) -> std::optional<std::string> {
-            if (v >= kFinestGpioResolutionUs) return std::nullopt;
+            if (v >= kFinestGpioResolutionUs && v <= kMaxDurationUs) return std::nullopt;
+            if (v > kMaxDurationUs) return fmt::format("must be <= {:g} (1000 s)", kMaxDurationUs);
             return fmt::format("must be >= {} (a userspace GPIO edge cannot be timed finer, even on PREEMPT_RT; "
                                "add a pulse_generator channel for us timing)",
                                kFinestGpioResolutionUs);

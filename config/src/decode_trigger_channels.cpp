@@ -82,7 +82,7 @@ void decode_timing_and_wiring(TableReader& r, const ChannelContext& ctx, Trigger
     r.issue("pulses", fmt::format("only light and flashlamp channels choose their pulses, and this channel's role is "
                                   "\"{}\": remove the key",
                                   ch.role));
-  r.read("delay_us", ch.delay_us, Need::optional, at_least(0.0));
+  r.read("delay_us", ch.delay_us, Need::optional, non_negative_time_us());
   double width = 0.0;
   if (r.read("width_us", width, Need::optional, positive_duration_us())) ch.width_us = width;
 

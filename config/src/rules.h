@@ -5,6 +5,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <fmt/format.h>
@@ -60,6 +61,20 @@ Rule<T> one_of(std::vector<T> allowed) {
     for (const auto& a : allowed)
       if (a == v) return std::nullopt;
     return fmt::format("must be one of {}", fmt::join(allowed, ", "));
+  }};
+}
+
+// `rule`, then v <= high; `why` (if any) says where the ceiling comes from.
+template <typename T>
+Rule<T> and_at_most(Rule<T> rule, T high, std::string why = {}) {
+  return {[rule = std::move(rule), high, why = std::move(why)](const T& v) -> std::optional<std::string> {
+    if (auto complaint = rule(v)) return complaint;
+    if (v <= high) return std::nullopt;
+    // Large ceilings read better as 1e+09 than as 1000000000.
+    std::string ceiling;
+    if constexpr (std::is_floating_point_v<T>) ceiling = fmt::format("{:g}", high);
+    else ceiling = fmt::format("{}", high);
+    return why.empty() ? "must be <= " + ceiling : fmt::format("must be <= {} ({})", ceiling, why);
   }};
 }
 

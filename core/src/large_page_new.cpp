@@ -25,13 +25,15 @@ constexpr std::size_t kLargeAllocationBytes = std::size_t{1} << 20;
 
 void* allocate(std::size_t bytes) noexcept {
   if (bytes >= kLargeAllocationBytes) {
-    if (void* p = std::aligned_alloc(kHugePageBytes, bytes)) {
-      // The advice covers the last, partly used huge page too: glibc's aligned allocation maps
-      // at least `bytes` + 2 MiB, and for a chunk from the heap the rest of that page is heap.
-      // A 4 KiB-page tail would cost up to 2 MiB of slow faults per buffer; the price is at
-      // most 2 MiB of resident memory per large buffer. Advice only: if the kernel has no huge
-      // pages to give, the memory is still valid.
-      madvise(p, (bytes + kHugePageBytes - 1) & ~(kHugePageBytes - 1), MADV_HUGEPAGE);
+    // aligned_alloc wants a size that is a multiple of the alignment (C11; glibc is lenient,
+    // sanitizers are not), so the buffer is rounded up to whole huge pages. That is also what
+    // the advice below covers: a 4 KiB-page tail would cost up to 2 MiB of slow faults per
+    // buffer; the price is at most 2 MiB of address space (resident once touched) per buffer.
+    if (bytes > SIZE_MAX - (kHugePageBytes - 1)) return nullptr;  // rounding would wrap: no such buffer
+    const std::size_t rounded = (bytes + kHugePageBytes - 1) & ~(kHugePageBytes - 1);
+    if (void* p = std::aligned_alloc(kHugePageBytes, rounded)) {
+      // Advice only: if the kernel has no huge pages to give, the memory is still valid.
+      madvise(p, rounded, MADV_HUGEPAGE);
       return p;
     }
   }

@@ -1,5 +1,6 @@
 #include "h5_attributes.h"
 
+#include <algorithm>
 #include <string>
 
 #include "h5_error.h"
@@ -36,13 +37,15 @@ std::size_t element_count(hid_t attr, const std::string& what) {
   return static_cast<std::size_t>(check(H5Sget_simple_extent_npoints(space.get()), "cannot read the shape of", what));
 }
 
-// Reads a one-element numeric attribute converted to `mem_type`.
-void read_scalar(hid_t object, const char* name, hid_t mem_type, void* out, std::string_view where) {
+// Reads a one-element numeric attribute converted to `mem_type`; `integer` refuses floats.
+void read_scalar(hid_t object, const char* name, hid_t mem_type, void* out, std::string_view where,
+                 bool integer = false) {
   const std::string what = attr_name(name, where);
   Attribute attr = open_attr(object, name, where);
   Datatype stored(check(H5Aget_type(attr.get()), "cannot read the type of", what));
   const H5T_class_t cls = H5Tget_class(stored.get());
   if (cls != H5T_INTEGER && cls != H5T_FLOAT) throw Failure(what + " is not a number");
+  if (integer && cls != H5T_INTEGER) throw Failure(what + " is a floating-point number; an integer is expected");
   if (element_count(attr.get(), what) != 1) throw Failure(what + " holds more than one value");
   check(H5Aread(attr.get(), mem_type, out), "cannot read", what);
 }
@@ -67,6 +70,25 @@ void write_string_list_attr(hid_t object, const char* name, const std::vector<st
   // An empty list still needs a non-null buffer: HDF5 refuses a null one even for 0 elements.
   const char* none = nullptr;
   write_attr(object, name, type.get(), space.get(), type.get(), values.empty() ? &none : pointers.data(), where);
+}
+
+void write_fixed_string_attr(hid_t object, const char* name, std::string_view value, std::string_view where) {
+  Datatype type = fixed_utf8_string_type(value.size());
+  std::string padded(value);
+  padded.resize(H5Tget_size(type.get()), '\0');
+  write_scalar(object, name, type.get(), type.get(), padded.data(), where);
+}
+
+void write_fixed_string_list_attr(hid_t object, const char* name, const std::vector<std::string>& values,
+                                  std::string_view where) {
+  std::size_t longest = 1;
+  for (const auto& v : values) longest = std::max(longest, v.size());
+  Datatype type = fixed_utf8_string_type(longest);
+  std::vector<char> packed(longest * std::max<std::size_t>(values.size(), 1), '\0');
+  for (std::size_t i = 0; i < values.size(); ++i) std::copy(values[i].begin(), values[i].end(), packed.begin() + i * longest);
+  const hsize_t dims[1] = {values.size()};
+  Dataspace space(check(H5Screate_simple(1, dims, nullptr), "cannot create", attr_name(name, where)));
+  write_attr(object, name, type.get(), space.get(), type.get(), packed.data(), where);
 }
 
 void write_int_attr(hid_t object, const char* name, std::int64_t value, hid_t file_type, std::string_view where) {
@@ -105,13 +127,13 @@ std::vector<std::string> read_string_list_attr(hid_t object, const char* name, s
 
 std::int64_t read_int_attr(hid_t object, const char* name, std::string_view where) {
   std::int64_t value = 0;
-  read_scalar(object, name, H5T_NATIVE_INT64, &value, where);
+  read_scalar(object, name, H5T_NATIVE_INT64, &value, where, true);
   return value;
 }
 
 std::uint64_t read_uint64_attr(hid_t object, const char* name, std::string_view where) {
   std::uint64_t value = 0;
-  read_scalar(object, name, H5T_NATIVE_UINT64, &value, where);
+  read_scalar(object, name, H5T_NATIVE_UINT64, &value, where, true);
   return value;
 }
 

@@ -1,8 +1,8 @@
 #pragma once
 // Reading and writing HDF5 attributes with the file types the session layout documents
 // (docs/file-formats.md). `where` names the object ("/cameras/cam0") in error messages.
-// Strings are written as variable-length UTF-8, which h5py returns as str and MATLAB's
-// h5readatt as char; the readers also accept fixed-length strings written by other tools.
+// Strings are written as variable-length UTF-8 (h5py returns str, MATLAB's h5readatt char) or,
+// for session files, as fixed-length UTF-8 (h5py returns bytes); the readers accept both.
 #include <hdf5.h>
 
 #include <cstdint>
@@ -16,6 +16,10 @@ namespace tomorig::storage::h5 {
 void write_string_attr(hid_t object, const char* name, std::string_view value, std::string_view where);
 void write_string_list_attr(hid_t object, const char* name, const std::vector<std::string>& values,
                             std::string_view where);
+// The same as fixed-length strings (see fixed_utf8_string_type), sized to the longest value.
+void write_fixed_string_attr(hid_t object, const char* name, std::string_view value, std::string_view where);
+void write_fixed_string_list_attr(hid_t object, const char* name, const std::vector<std::string>& values,
+                                  std::string_view where);
 // `file_type` is the integer type stored in the file, e.g. H5T_STD_I32LE.
 void write_int_attr(hid_t object, const char* name, std::int64_t value, hid_t file_type, std::string_view where);
 void write_uint64_attr(hid_t object, const char* name, std::uint64_t value, std::string_view where);
@@ -26,7 +30,9 @@ void write_doubles_attr(hid_t object, const char* name, std::span<const double> 
 
 bool has_attr(hid_t object, const char* name);
 // The readers throw h5::Failure naming the attribute and object when it is missing or has
-// the wrong class or size; numeric values are converted by HDF5 from whatever type is stored.
+// the wrong class or size; numeric values are converted by HDF5 from whatever type is stored,
+// except that the integer readers refuse a floating-point attribute (a stored 1.5 is not a
+// count or a version).
 std::string read_string_attr(hid_t object, const char* name, std::string_view where);
 std::vector<std::string> read_string_list_attr(hid_t object, const char* name, std::string_view where);
 std::int64_t read_int_attr(hid_t object, const char* name, std::string_view where);

@@ -111,6 +111,16 @@ void write_string_dataset(hid_t location, const char* name, std::string_view tex
   check(H5Dwrite(dataset.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, &pointer), "cannot write", where);
 }
 
+void write_fixed_string_dataset(hid_t location, const char* name, std::string_view text, std::string_view where) {
+  Datatype type = fixed_utf8_string_type(text.size());
+  Dataspace space(check(H5Screate(H5S_SCALAR), "cannot create", where));
+  Dataset dataset(check(H5Dcreate2(location, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+                        "cannot create", where));
+  std::string padded(text);
+  padded.resize(H5Tget_size(type.get()), '\0');
+  check(H5Dwrite(dataset.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, padded.data()), "cannot write", where);
+}
+
 std::string read_string_dataset(hid_t location, const char* name, std::string_view where) {
   Dataset dataset = open_dataset(location, name, where);
   auto values = read_strings(dataset.get(), StringSource::dataset, where);

@@ -45,8 +45,10 @@ void read_all(hid_t dataset, hid_t mem_type, void* out, std::string_view where);
 void write_dataset(hid_t location, const char* name, hid_t file_type, std::span<const hsize_t> dims,
                    hid_t mem_type, const void* data, std::string_view where);
 
-// A scalar variable-length UTF-8 string dataset (e.g. /config).
+// A scalar variable-length UTF-8 string dataset (e.g. /parameters of results files).
 void write_string_dataset(hid_t location, const char* name, std::string_view text, std::string_view where);
+// A scalar fixed-length UTF-8 string dataset as long as `text` (/config of session files).
+void write_fixed_string_dataset(hid_t location, const char* name, std::string_view text, std::string_view where);
 std::string read_string_dataset(hid_t location, const char* name, std::string_view where);
 
 // A chunked dataset whose first dimension starts at 0 and grows without limit, one set at a

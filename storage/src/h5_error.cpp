@@ -32,7 +32,7 @@ herr_t collect(unsigned /*n*/, const H5E_error2_t* error, void* client) {
 std::string error_stack_text() {
   std::vector<std::string> messages;  // outermost (the API call) first
   H5Ewalk2(H5E_DEFAULT, H5E_WALK_DOWNWARD, collect, &messages);
-  if (messages.empty()) return "no reason given by HDF5";
+  if (messages.empty()) return std::string(kNoReason);
   const std::string& outer = messages.front();
   const std::string& inner = messages.back();
   return messages.size() == 1 || outer == inner ? inner : outer + " (" + inner + ")";

@@ -25,6 +25,7 @@ void silence_errors();
 // HDF5's reason for the failure that just happened: the outermost and innermost messages of
 // the calling thread's error stack, e.g. "unable to open file (truncated file: eof = 800, ...)".
 std::string error_stack_text();
+inline constexpr std::string_view kNoReason = "no reason given by HDF5";  // what it returns for an empty stack
 
 // Throws Failure("<action> <object>: <reason>") when an HDF5 call returned a negative value.
 // The message is built only on failure, so this is free on the hot path.

@@ -24,9 +24,20 @@ File open_for_reading(const std::filesystem::path& path, std::string_view kind) 
   hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   // A live recording (SWMR) refuses plain readers while it is written, and after a crash its
   // superblock still says "open for writing"; a SWMR reader reads both.
-  if (id < 0) id = H5Fopen(path.c_str(), H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, H5P_DEFAULT);
+  std::string plain_reason;
   if (id < 0) {
-    const std::string reason = error_stack_text();
+    plain_reason = error_stack_text();
+    // A SWMR reader takes a metadata checksum failure for a block the writer is rewriting and
+    // reads it again, sleeping 1 ns, 2 ns, 4 ns, ... in between: HDF5's 100 attempts would
+    // sleep for centuries on a block that is damaged, not torn. 24 attempts re-read for about
+    // 17 ms, far longer than a writer takes to write a block.
+    PropertyList fapl(H5Pcreate(H5P_FILE_ACCESS));
+    if (fapl.valid()) H5Pset_metadata_read_attempts(fapl.get(), kSwmrReadAttempts);
+    id = H5Fopen(path.c_str(), H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, fapl.valid() ? fapl.get() : H5P_DEFAULT);
+  }
+  if (id < 0) {
+    std::string reason = error_stack_text();
+    if (reason == kNoReason) reason = plain_reason;
     std::string lower = reason;
     std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
     // HDF5 1.10 locks files; a writer that has the file open holds the lock.

@@ -9,6 +9,9 @@
 
 namespace tomorig::storage::h5 {
 
+// Metadata read attempts of a SWMR reader (see h5_open.cpp; HDF5's default is 100).
+inline constexpr unsigned kSwmrReadAttempts = 24;
+
 // Throws tomorig::Error (bad_input) naming `kind` ("session file", "volume file") and the path.
 File open_for_reading(const std::filesystem::path& path, std::string_view kind);
 

@@ -14,6 +14,14 @@ Datatype utf8_string_type() {
   return type;
 }
 
+Datatype fixed_utf8_string_type(std::size_t bytes) {
+  Datatype type(check(H5Tcopy(H5T_C_S1), "cannot create", "a string type"));
+  check(H5Tset_size(type.get(), bytes == 0 ? 1 : bytes), "cannot create", "a string type");
+  check(H5Tset_strpad(type.get(), H5T_STR_NULLPAD), "cannot create", "a string type");
+  check(H5Tset_cset(type.get(), H5T_CSET_UTF8), "cannot create", "a string type");
+  return type;
+}
+
 namespace {
 
 herr_t read_raw(hid_t object, StringSource source, hid_t mem_type, void* buffer) {

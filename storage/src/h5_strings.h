@@ -10,8 +10,13 @@
 
 namespace tomorig::storage::h5 {
 
-// Variable-length UTF-8 string type, what tomorig writes.
+// Variable-length UTF-8 string type: what results and volume files (and session files of
+// format version 1) hold.
 Datatype utf8_string_type();
+// Fixed-length UTF-8 string type of `bytes` bytes (at least 1), padded with NULs: what session
+// files of format version 2 hold. Unlike variable-length strings, whose bytes live in a global
+// heap that libhdf5 1.10 reads without bounds checks, these are read straight from the object.
+Datatype fixed_utf8_string_type(std::size_t bytes);
 
 // All strings held by an open attribute or dataset (`source` says which), whether stored
 // as variable- or fixed-length strings; HDF5's variable-length buffers are freed here.

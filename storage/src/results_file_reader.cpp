@@ -18,6 +18,7 @@
 #include "h5_error.h"
 #include "h5_handle.h"
 #include "h5_open.h"
+#include "isolated_probe.h"
 #include "results_file_layout.h"
 #include "results_file_rows.h"
 #include "results_layout.h"
@@ -230,7 +231,12 @@ SetResult ResultsReader::Impl::read_v2_set(std::uint64_t index, hsize_t row) con
   return r;
 }
 
-ResultsReader::ResultsReader(const fs::path& path) : impl_(std::make_unique<Impl>(path)) {}
+ResultsReader::ResultsReader(const fs::path& path) {
+  h5::silence_errors();
+  // The open pass runs in a child first: a library crash on a damaged file ends only the child.
+  require_safe_to_read([&] { const Impl probe(path); }, "results file", path);
+  impl_ = std::make_unique<Impl>(path);
+}
 ResultsReader::~ResultsReader() = default;
 
 const ResultsInfo& ResultsReader::info() const { return impl_->info; }

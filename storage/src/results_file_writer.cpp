@@ -28,6 +28,7 @@
 #include "h5_datasets.h"
 #include "h5_error.h"
 #include "h5_handle.h"
+#include "output_lock.h"
 #include "output_path.h"
 #include "partial_file.h"
 #include "results_file_create.h"
@@ -81,6 +82,7 @@ void write_text_atomically(const fs::path& path, const std::string& text) {
 }  // namespace
 
 struct ResultsWriter::Impl {
+  OutputLock lock;  // held for the writer's life: one writer per results file
   fs::path path;
   ResultsInfo info;
   std::string created_utc;
@@ -270,9 +272,10 @@ ResultsWriter::ResultsWriter(const fs::path& path, const ResultsInfo& info, cons
   m.stats = EnsembleAccumulator(info.voxel_size_mm);
   if (!(info.voxel_size_mm > 0))
     throw bad_input(fmt::format("results file '{}': voxel size {} mm must be > 0", path.string(), info.voxel_size_mm));
+  check_output_path(path, true, "results");
+  m.lock = OutputLock::acquire(path, "results");  // before the file is looked at: its content is ours now
   std::error_code ec;
   const bool resume = !options.overwrite && fs::exists(path, ec);
-  check_output_path(path, true, "results");
   if (!resume) return;
   const ResultsReader existing(path);
   const ResultsInfo& old = existing.info();

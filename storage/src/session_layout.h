@@ -4,6 +4,7 @@
 // together, and bump kFormatVersion when an old reader could misread a new file.
 #include <hdf5.h>
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -13,7 +14,27 @@
 namespace tomorig::storage::layout {
 
 inline constexpr std::string_view kFormatName = "tomorig-session";
-inline constexpr int kFormatVersion = 1;
+// Version 2 stores every string (attributes and /config) as a fixed-length string; version 1
+// used variable-length strings, which libhdf5 1.10 reads from a global heap without bounds
+// checks (a damaged file crashed it). Both are read; only version 2 is written.
+inline constexpr int kFormatVersion = 2;
+inline constexpr int kOldestFormatVersion = 1;
+
+// Limits a session file must keep, checked by the writer and by the reader before it
+// allocates anything a file declares:
+//  - cameras per session: a rig has a handful (the wire format could carry 32767), and the
+//    /cameras 'order' attribute of 256 ids of kMaxCameraIdBytes stays within the 64 KiB an
+//    HDF5 attribute may take in a file of the oldest format;
+inline constexpr std::size_t kMaxCameras = 256;
+//  - image sides, as the wire format allows (stream/wire_format.h);
+inline constexpr std::int64_t kMaxImageSide = std::int64_t{1} << 16;
+//  - bytes per frame: a frame is one HDF5 chunk, and HDF5 chunks are smaller than 4 GiB;
+inline constexpr std::uint64_t kMaxFrameBytes = (std::uint64_t{1} << 32) - 1;
+//  - memory the per-set records held by a reader may take, as a multiple of the file's size
+//    (tomorig stores them uncompressed, so a real file holds at least that many bytes; 16x
+//    leaves room for files compressed by other tools), with a floor for tiny files.
+inline constexpr std::uint64_t kRecordBytesPerFileByte = 16;
+inline constexpr std::uint64_t kRecordBytesFloor = std::uint64_t{64} << 20;
 
 // Root attributes.
 inline constexpr const char* kAttrFormat = "format";

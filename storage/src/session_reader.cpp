@@ -4,7 +4,9 @@
 #include <array>
 #include <cctype>
 #include <filesystem>
+#include <limits>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include <fmt/format.h>
@@ -16,7 +18,9 @@
 #include "h5_error.h"
 #include "h5_handle.h"
 #include "h5_open.h"
+#include "isolated_probe.h"
 #include "session_layout.h"
+#include "tomorig/core/camera_id.h"
 #include "tomorig/core/error.h"
 #include "tomorig/storage/session_file.h"
 
@@ -53,6 +57,41 @@ void check_frame_type(hid_t dataset, const SessionCamera& camera, const std::str
                                   to_string(camera.pixel_format), wanted));
 }
 
+// a * b, or nothing if it does not fit in 64 bits.
+std::optional<std::uint64_t> checked_product(std::uint64_t a, std::uint64_t b) {
+  if (a != 0 && b > std::numeric_limits<std::uint64_t>::max() / a) return std::nullopt;
+  return a * b;
+}
+
+bool has_filters(hid_t dataset, const std::string& where) {
+  h5::PropertyList dcpl(h5::check(H5Dget_create_plist(dataset), "cannot read the creation properties of", where));
+  return h5::check(H5Pget_nfilters(dcpl.get()), "cannot read the filters of", where) > 0;
+}
+
+// An integer attribute that must lie in [low, high], checked before it is narrowed to int.
+int read_bounded_int(hid_t object, const char* name, std::int64_t low, std::int64_t high, const std::string& where) {
+  const std::int64_t value = h5::read_int_attr(object, name, where);
+  if (value < low || value > high)
+    throw h5::Failure(fmt::format("attribute '{}' of {} is {}; it must be {} to {}", name, where, value, low, high));
+  return static_cast<int>(value);
+}
+
+// Camera ids of an 'order' attribute: each valid (core/camera_id.h) and none twice. A damaged
+// or hand-made file listing one camera four times would otherwise show one camera's frames as
+// four views.
+void check_order(const std::vector<std::string>& order, const std::string& where) {
+  if (order.size() > layout::kMaxCameras)
+    throw h5::Failure(fmt::format("{} lists {} cameras; a session holds at most {}", where, order.size(),
+                                  layout::kMaxCameras));
+  std::unordered_set<std::string> seen;
+  for (const std::string& id : order) {
+    if (const auto problem = camera_id_problem(id))
+      throw h5::Failure(fmt::format("{} lists camera id \"{}\", which is not allowed: it {}", where, printable(id),
+                                    *problem));
+    if (!seen.insert(id).second) throw h5::Failure(fmt::format("{} lists camera '{}' twice", where, id));
+  }
+}
+
 }  // namespace
 
 struct SessionReader::Impl {
@@ -75,9 +114,21 @@ struct SessionReader::Impl {
   template <typename T>
   std::vector<T> read_set_dataset(hid_t group, const char* name, hid_t mem_type, std::vector<hsize_t> record_shape);
   void check_index(std::uint64_t set_index) const;
+  // Throws corrupt() unless `bytes` more of memory is within what a file of this size may
+  // make a reader allocate (session_layout.h).
+  void require_memory(std::optional<std::uint64_t> bytes, const std::string& what) const;
+  // Unfiltered datasets store every element written: fewer stored bytes than declared means
+  // the extent was damaged (or never written). Filtered ones are bounded by require_memory.
+  void require_stored(hid_t dataset, std::optional<std::uint64_t> bytes, const std::string& where) const;
+  void check_frame_storage();
   h5::Group truth_sets_group() const;
+  SessionTruth read_truth() const;
+  TruthSet read_truth_set(std::uint64_t set_index, bool headers_only) const;
+  // For the isolated probe: the objects read later on demand (truth metadata, truth sets' headers).
+  void touch_lazily_read_objects() const;
 
   fs::path path;
+  std::uint64_t file_bytes = 0;
   h5::File file;
   SessionInfo info;
   int format_version = 0;
@@ -107,7 +158,32 @@ SessionReader::Impl::Impl(const fs::path& p) : path(p) {
   }
 }
 
-void SessionReader::Impl::open_file() { file = h5::open_for_reading(path, "session file"); }
+void SessionReader::Impl::open_file() {
+  file = h5::open_for_reading(path, "session file");
+  std::error_code ec;
+  file_bytes = fs::file_size(path, ec);
+  if (ec) file_bytes = 0;
+}
+
+void SessionReader::Impl::require_memory(std::optional<std::uint64_t> bytes, const std::string& what) const {
+  const std::uint64_t limit = std::max(layout::kRecordBytesFloor,
+                                       checked_product(file_bytes, layout::kRecordBytesPerFileByte)
+                                           .value_or(std::numeric_limits<std::uint64_t>::max()));
+  if (!bytes || *bytes > limit)
+    corrupt(fmt::format("{} would take {} of memory, more than a {}-byte file can hold (at most {} bytes); its "
+                        "declared size is damaged",
+                        what, bytes ? fmt::format("{} bytes", *bytes) : std::string("more than 2^64 bytes"),
+                        file_bytes, limit));
+}
+
+void SessionReader::Impl::require_stored(hid_t dataset, std::optional<std::uint64_t> bytes,
+                                         const std::string& where) const {
+  if (has_filters(dataset, where)) return;
+  const hsize_t stored = H5Dget_storage_size(dataset);
+  if (!bytes || stored < *bytes)
+    corrupt(fmt::format("{} declares {} bytes of data but the file stores {}", where,
+                        bytes ? std::to_string(*bytes) : std::string("more than 2^64"), stored));
+}
 
 void SessionReader::Impl::read_root() {
   const hid_t root = file.get();
@@ -120,10 +196,10 @@ void SessionReader::Impl::read_root() {
                         layout::kFormatName));
   if (!h5::has_attr(root, layout::kAttrFormatVersion))
     invalid(fmt::format("the root attribute '{}' is missing", layout::kAttrFormatVersion));
-  const std::int64_t version = h5::read_int_attr(root, layout::kAttrFormatVersion, "/");
-  if (version < 1 || version > layout::kFormatVersion)
-    throw bad_input(fmt::format("session file '{}' has format version {}, but this tomorig reads versions 1 to {}{}",
-                                path.string(), version, layout::kFormatVersion,
+  const std::int64_t version = h5::read_int_attr(root, layout::kAttrFormatVersion, "/");  // an integer, not 1.0
+  if (version < layout::kOldestFormatVersion || version > layout::kFormatVersion)
+    throw bad_input(fmt::format("session file '{}' has format version {}, but this tomorig reads versions {} to {}{}",
+                                path.string(), version, layout::kOldestFormatVersion, layout::kFormatVersion,
                                 version > layout::kFormatVersion ? ": update tomorig to read it" : ""));
   format_version = static_cast<int>(version);
 
@@ -149,18 +225,29 @@ void SessionReader::Impl::read_cameras() {
   h5::Group group = h5::open_group(file.get(), layout::kCameras, "/cameras");
   const std::vector<std::string> order = h5::read_string_list_attr(group.get(), layout::kAttrOrder, "/cameras");
   if (order.empty()) invalid("/cameras lists no cameras");
+  try {
+    check_order(order, "/cameras 'order'");
+  } catch (const h5::Failure& failure) {
+    invalid(failure.what());
+  }
 
-  for (const std::string& id : order) {
+  for (std::size_t position = 0; position < order.size(); ++position) {
+    const std::string& id = order[position];
     const std::string where = layout::camera_path(id);
-    if (id.empty() || !h5::link_exists(group.get(), id.c_str()))
+    if (!h5::link_exists(group.get(), id.c_str()))
       invalid(fmt::format("camera '{}' is listed in /cameras 'order' but {} is missing", id, where));
     h5::Group cam = h5::open_group(group.get(), id.c_str(), where);
     SessionCamera camera;
     camera.id = id;
-    camera.width = static_cast<int>(h5::read_int_attr(cam.get(), layout::kAttrWidth, where));
-    camera.height = static_cast<int>(h5::read_int_attr(cam.get(), layout::kAttrHeight, where));
-    if (camera.width <= 0 || camera.height <= 0)
-      invalid(fmt::format("camera {} has size {} x {}", id, camera.width, camera.height));
+    camera.width = read_bounded_int(cam.get(), layout::kAttrWidth, 1, layout::kMaxImageSide, where);
+    camera.height = read_bounded_int(cam.get(), layout::kAttrHeight, 1, layout::kMaxImageSide, where);
+    // The camera's place in the session: every per-camera record is indexed by it.
+    if (h5::has_attr(cam.get(), layout::kAttrIndex)) {
+      const std::int64_t index = h5::read_int_attr(cam.get(), layout::kAttrIndex, where);
+      if (index != static_cast<std::int64_t>(position))
+        invalid(fmt::format("camera {} has index {} but is listed at position {} in /cameras 'order'", id, index,
+                            position));
+    }
     const std::string format = h5::read_string_attr(cam.get(), layout::kAttrPixelFormat, where);
     const auto pixel_format = parse_pixel_format(format);
     if (!pixel_format)
@@ -181,6 +268,14 @@ void SessionReader::Impl::read_cameras() {
       invalid(fmt::format("camera {}: frames are {} x {} but the session says {} x {}", id, dims[3], dims[2],
                           camera.width, camera.height));
     check_frame_type(ds.frames.get(), camera, ds.where);
+    const std::uint64_t frame_bytes = static_cast<std::uint64_t>(camera.width) *
+                                      static_cast<std::uint64_t>(camera.height) *
+                                      bytes_per_sample(sample_type_of(camera.pixel_format));
+    if (frame_bytes > layout::kMaxFrameBytes)
+      invalid(fmt::format("camera {} declares {} x {} {} frames of {} bytes; a frame is one HDF5 chunk, at most {} "
+                          "bytes",
+                          id, camera.width, camera.height, to_string(camera.pixel_format), frame_bytes,
+                          layout::kMaxFrameBytes));
     // Reopened with a chunk cache suited to whole-frame reads (see frame_chunk_cache_bytes).
     ds.frames = h5::open_dataset(cam.get(), layout::kFrames,
                                  h5::frame_chunk_cache_bytes(filtered, dims[2] * dims[3] *
@@ -232,8 +327,22 @@ std::vector<T> SessionReader::Impl::read_set_dataset(hid_t group, const char* na
     invalid(fmt::format("{} has shape [{}] but should be [{}]", where, fmt::join(dims, ", "), fmt::join(expected, ", ")));
   if (dims[0] != sets && (recording_complete || dims[0] < sets))
     corrupt(fmt::format("{} holds {} sets but the camera frames hold {}", where, dims[0], sets));
-  std::size_t stored = 1;
-  for (hsize_t d : dims) stored *= d;
+  // Integers only: HDF5 would convert a float dt_ns (or frame_present) without a word.
+  {
+    h5::Datatype type(h5::check(H5Dget_type(dataset.get()), "cannot read the type of", where));
+    if (H5Tget_class(type.get()) != H5T_INTEGER)
+      invalid(fmt::format("{} holds {}; integers are expected", where,
+                          H5Tget_class(type.get()) == H5T_FLOAT ? "floating-point numbers" : "non-integers"));
+    // The sets that count, not the extent: an interrupted live recording may have grown a
+    // dataset for a set it never wrote.
+    std::optional<std::uint64_t> stored_bytes = H5Tget_size(type.get());
+    for (hsize_t d : expected) stored_bytes = stored_bytes ? checked_product(*stored_bytes, d) : std::nullopt;
+    require_stored(dataset.get(), stored_bytes, where);
+  }
+  std::optional<std::uint64_t> count = 1;
+  for (hsize_t d : dims) count = count ? checked_product(*count, d) : std::nullopt;
+  require_memory(count ? checked_product(*count, sizeof(T)) : std::nullopt, where);
+  const auto stored = static_cast<std::size_t>(*count);
   std::vector<T> values(stored);
   if (stored > 0) h5::read_all(dataset.get(), mem_type, values.data(), where);
   std::size_t n = 1;
@@ -252,7 +361,9 @@ void SessionReader::Impl::read_sets() {
                              layout::kFramePresent})
       if (h5::link_exists(group.get(), name)) {
         h5::Dataset d = h5::open_dataset(group.get(), name, layout::sets_path(name));
-        sets = std::min<std::uint64_t>(sets, h5::dims_of(d.get(), layout::sets_path(name)).at(0));
+        const std::vector<hsize_t> dims = h5::dims_of(d.get(), layout::sets_path(name));
+        if (dims.empty()) invalid(fmt::format("{} is a scalar; it should have one record per set", layout::sets_path(name)));
+        sets = std::min<std::uint64_t>(sets, dims[0]);
       }
   }
   trigger_index = read_set_dataset<std::uint64_t>(group.get(), layout::kTriggerIndex, H5T_NATIVE_UINT64, {});
@@ -264,11 +375,35 @@ void SessionReader::Impl::read_sets() {
   const std::size_t per_set = 2 * cameras.size();
   for (std::uint64_t s = 0; s < sets; ++s) {
     const auto first = frame_present.begin() + static_cast<std::ptrdiff_t>(s * per_set);
+    for (std::size_t k = 0; k < per_set; ++k)
+      if (first[static_cast<std::ptrdiff_t>(k)] > 1)
+        corrupt(fmt::format("/sets/frame_present of set {}, camera {}, frame {} is {}; it must be 0 (missing) or 1 "
+                            "(present)",
+                            s, info.cameras[k / 2].id, k % 2 == 0 ? 'A' : 'B', first[static_cast<std::ptrdiff_t>(k)]));
     const auto lost = std::count(first, first + static_cast<std::ptrdiff_t>(per_set), std::uint8_t{0});
     // 2: a free-running camera's frame, present but not of this event: the set is not complete.
     const auto unsynchronised = std::count(first, first + static_cast<std::ptrdiff_t>(per_set), std::uint8_t{2});
     missing += static_cast<int>(lost);
     incomplete += lost + unsynchronised > 0 ? 1 : 0;
+  }
+  check_frame_storage();
+}
+
+// A present frame of an unfiltered camera is one allocated chunk of exactly a frame: the file
+// must store at least that many bytes, or the flags (or the extent) were damaged.
+void SessionReader::Impl::check_frame_storage() {
+  const std::size_t n = cameras.size();
+  for (std::size_t c = 0; c < n; ++c) {
+    std::uint64_t present = 0;
+    for (std::uint64_t s = 0; s < sets; ++s) present += frame_present[(s * n + c) * 2] + frame_present[(s * n + c) * 2 + 1];
+    const SessionCamera& camera = info.cameras[c];
+    const std::uint64_t frame_bytes = static_cast<std::uint64_t>(camera.width) * camera.height *
+                                      bytes_per_sample(cameras[c].sample_type);
+    if (has_filters(cameras[c].frames.get(), cameras[c].where)) continue;
+    const hsize_t stored = H5Dget_storage_size(cameras[c].frames.get());
+    if (stored / frame_bytes < present)
+      corrupt(fmt::format("camera {}: {} frames are marked present but {} stores {}", camera.id, present,
+                          cameras[c].where, stored / frame_bytes));
   }
 }
 
@@ -289,6 +424,14 @@ h5::Group SessionReader::Impl::truth_sets_group() const {
 
 SessionReader::SessionReader(const fs::path& path) {
   h5::silence_errors();
+  // Everything this reader will ask libhdf5 to parse is parsed first in a child process, where a
+  // library crash or endless loop on a damaged file ends only the child (isolated_probe.h).
+  require_safe_to_read(
+      [&] {
+        const Impl probe(path);
+        probe.touch_lazily_read_objects();
+      },
+      "session file", path);
   impl_ = std::make_unique<Impl>(path);
 }
 
@@ -358,13 +501,10 @@ FrameSet SessionReader::read_set(std::uint64_t set_index) const {
   return set;
 }
 
-SessionTruth SessionReader::truth() const {
-  h5::silence_errors();
-  const Impl& m = *impl_;
-  if (!m.truth) throw bad_input(fmt::format("session '{}' holds no truth (only simulated sessions do)", m.path.string()));
+SessionTruth SessionReader::Impl::read_truth() const {
   SessionTruth truth;
   try {
-    h5::Group group = h5::open_group(m.file.get(), layout::kTruth, "/truth");
+    h5::Group group = h5::open_group(file.get(), layout::kTruth, "/truth");
     truth.case_name = h5::read_string_attr(group.get(), layout::kAttrCase, "/truth");
     truth.flow_name = h5::read_string_attr(group.get(), layout::kAttrFlow, "/truth");
     truth.flow_parameters = h5::read_string_attr(group.get(), layout::kAttrFlowParameters, "/truth");
@@ -372,7 +512,10 @@ SessionTruth SessionReader::truth() const {
     truth.ppp = h5::read_double_attr(group.get(), layout::kAttrPpp, "/truth");
     if (!h5::link_exists(group.get(), layout::kCameras)) return truth;
     h5::Group cameras = h5::open_group(group.get(), layout::kCameras, "/truth/cameras");
-    for (const std::string& id : h5::read_string_list_attr(cameras.get(), layout::kAttrOrder, "/truth/cameras")) {
+    const std::vector<std::string> order =
+        h5::read_string_list_attr(cameras.get(), layout::kAttrOrder, "/truth/cameras");
+    check_order(order, "/truth/cameras 'order'");
+    for (const std::string& id : order) {
       const std::string where = "/truth/cameras/" + id;
       h5::Group g = h5::open_group(cameras.get(), id.c_str(), where);
       TruthCamera c;
@@ -384,14 +527,58 @@ SessionTruth SessionReader::truth() const {
       std::copy(K.begin(), K.end(), c.K.begin());
       std::copy(R.begin(), R.end(), c.R.begin());
       c.t = {t[0], t[1], t[2]};
-      c.width = static_cast<int>(h5::read_int_attr(g.get(), layout::kAttrWidth, where));
-      c.height = static_cast<int>(h5::read_int_attr(g.get(), layout::kAttrHeight, where));
+      c.width = read_bounded_int(g.get(), layout::kAttrWidth, 1, layout::kMaxImageSide, where);
+      c.height = read_bounded_int(g.get(), layout::kAttrHeight, 1, layout::kMaxImageSide, where);
       truth.cameras.push_back(std::move(c));
     }
   } catch (const h5::Failure& failure) {
-    m.corrupt(failure.what());
+    corrupt(failure.what());
   }
   return truth;
+}
+
+TruthSet SessionReader::Impl::read_truth_set(std::uint64_t set_index, bool headers_only) const {
+  TruthSet truth;
+  try {
+    h5::Group sets_group = truth_sets_group();
+    const std::string where = layout::truth_set_path(set_index);
+    h5::Group g = h5::open_group(sets_group.get(), layout::truth_set_name(set_index).c_str(), where);
+    for (const auto& [name, particles] : {std::pair{layout::kParticlesA, &truth.particles_a},
+                                          std::pair{layout::kParticlesB, &truth.particles_b}}) {
+      const std::string dataset_path = where + "/" + name;
+      h5::Dataset ds = h5::open_dataset(g.get(), name, dataset_path);
+      const std::vector<hsize_t> dims = h5::dims_of(ds.get(), dataset_path);
+      if (dims.size() != 2 || dims[1] != 3)
+        invalid(fmt::format("{} should have shape [N, 3] (x, y, z in mm)", dataset_path));
+      const auto bytes = checked_product(dims[0], sizeof(Vec3d));
+      require_stored(ds.get(), bytes, dataset_path);
+      require_memory(bytes, dataset_path);
+      if (headers_only) continue;
+      particles->resize(dims[0]);
+      if (dims[0] > 0) h5::read_all(ds.get(), H5T_NATIVE_DOUBLE, particles->data(), dataset_path);
+    }
+  } catch (const h5::Failure& failure) {
+    corrupt(failure.what());
+  }
+  return truth;
+}
+
+void SessionReader::Impl::touch_lazily_read_objects() const {
+  if (!truth) return;
+  read_truth();
+  h5::Group sets_group = truth_sets_group();
+  if (!sets_group.valid()) return;
+  H5G_info_t group_info{};
+  h5::check(H5Gget_info(sets_group.get(), &group_info), "cannot list", "/truth/sets");
+  for (std::uint64_t k = 0; k < sets; ++k)
+    if (h5::link_exists(sets_group.get(), layout::truth_set_name(k).c_str())) read_truth_set(k, true);
+}
+
+SessionTruth SessionReader::truth() const {
+  h5::silence_errors();
+  const Impl& m = *impl_;
+  if (!m.truth) throw bad_input(fmt::format("session '{}' holds no truth (only simulated sessions do)", m.path.string()));
+  return m.read_truth();
 }
 
 bool SessionReader::has_truth_set(std::uint64_t set_index) const {
@@ -424,25 +611,7 @@ TruthSet SessionReader::truth_set(std::uint64_t set_index) const {
   const Impl& m = *impl_;
   if (!has_truth_set(set_index))
     throw bad_input(fmt::format("session '{}' holds no truth for set {}", m.path.string(), set_index));
-  TruthSet truth;
-  try {
-    h5::Group sets = m.truth_sets_group();
-    const std::string where = layout::truth_set_path(set_index);
-    h5::Group g = h5::open_group(sets.get(), layout::truth_set_name(set_index).c_str(), where);
-    for (const auto& [name, particles] : {std::pair{layout::kParticlesA, &truth.particles_a},
-                                          std::pair{layout::kParticlesB, &truth.particles_b}}) {
-      const std::string path = where + "/" + name;
-      h5::Dataset ds = h5::open_dataset(g.get(), name, path);
-      const std::vector<hsize_t> dims = h5::dims_of(ds.get(), path);
-      if (dims.size() != 2 || dims[1] != 3)
-        m.invalid(fmt::format("{} should have shape [N, 3] (x, y, z in mm)", path));
-      particles->resize(dims[0]);
-      if (dims[0] > 0) h5::read_all(ds.get(), H5T_NATIVE_DOUBLE, particles->data(), path);
-    }
-  } catch (const h5::Failure& failure) {
-    m.corrupt(failure.what());
-  }
-  return truth;
+  return m.read_truth_set(set_index, false);
 }
 
 }  // namespace tomorig::storage

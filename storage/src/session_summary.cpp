@@ -1,6 +1,7 @@
 #include "tomorig/storage/session_summary.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <system_error>
 
 namespace tomorig::storage {
@@ -36,7 +37,11 @@ SessionSummary summarize(const SessionReader& reader) {
     s.first_trigger_index = std::min(s.first_trigger_index, r.trigger_index);
     s.last_trigger_index = std::max(s.last_trigger_index, r.trigger_index);
   }
-  s.time_span_s = static_cast<double>(s.last_trigger_ns - s.first_trigger_ns) * 1e-9;
+  // last >= first, so the difference is in [0, 2^64): exact in unsigned arithmetic, where the
+  // signed subtraction would overflow for timestamps far apart (INT64_MIN and INT64_MAX).
+  const std::uint64_t span_ns =
+      static_cast<std::uint64_t>(s.last_trigger_ns) - static_cast<std::uint64_t>(s.first_trigger_ns);
+  s.time_span_s = static_cast<double>(span_ns) * 1e-9;
 
   s.recording_complete = reader.recording_complete();
   s.truth = reader.has_truth();

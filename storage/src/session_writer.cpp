@@ -19,9 +19,11 @@
 #include "h5_datasets.h"
 #include "h5_error.h"
 #include "h5_handle.h"
+#include "output_lock.h"
 #include "output_path.h"
 #include "partial_file.h"
 #include "session_layout.h"
+#include "tomorig/core/camera_id.h"
 #include "tomorig/core/error.h"
 #include "tomorig/core/version.h"
 #include "tomorig/storage/session_file.h"
@@ -31,27 +33,48 @@ namespace tomorig::storage {
 namespace fs = std::filesystem;
 namespace {
 
-// An id becomes an HDF5 link name, so it cannot contain '/' or be "." (HDF5's "this group").
+// An id becomes an HDF5 link name and part of file names: one rule for every id (core/camera_id.h).
 void check_object_name(const std::string& id, const std::string& what, const fs::path& file) {
-  if (id.empty()) throw bad_input(fmt::format("session '{}': {} id is empty", file.string(), what));
-  if (id.find('/') != std::string::npos || id == "." || id == "..")
-    throw bad_input(fmt::format("session '{}': {} id '{}' is not allowed: ids cannot contain '/' or be '.' or '..'",
-                                file.string(), what, id));
+  require_valid_camera_id(id, fmt::format("session '{}', {}", file.string(), what));
 }
 
 void check_cameras(const std::vector<SessionCamera>& cameras, const fs::path& file) {
   if (cameras.empty()) throw bad_input(fmt::format("session '{}' needs at least one camera", file.string()));
+  if (cameras.size() > layout::kMaxCameras)
+    throw bad_input(fmt::format("session '{}' would have {} cameras; a session holds at most {}", file.string(),
+                                cameras.size(), layout::kMaxCameras));
   std::unordered_set<std::string> seen;
   for (const auto& c : cameras) {
     check_object_name(c.id, "camera", file);
     if (!seen.insert(c.id).second)
       throw bad_input(fmt::format("session '{}': camera id '{}' appears twice", file.string(), c.id));
-    if (c.width <= 0 || c.height <= 0)
-      throw bad_input(fmt::format("session '{}': camera {} has size {} x {}; width and height must be > 0",
-                                  file.string(), c.id, c.width, c.height));
+    if (c.width <= 0 || c.height <= 0 || c.width > layout::kMaxImageSide || c.height > layout::kMaxImageSide)
+      throw bad_input(fmt::format("session '{}': camera {} has size {} x {}; width and height must be 1 to {}",
+                                  file.string(), c.id, c.width, c.height, layout::kMaxImageSide));
+    const std::uint64_t frame_bytes = static_cast<std::uint64_t>(c.width) * static_cast<std::uint64_t>(c.height) *
+                                      bytes_per_sample(sample_type_of(c.pixel_format));
+    if (frame_bytes > layout::kMaxFrameBytes)
+      throw bad_input(fmt::format("session '{}': camera {} frames of {} x {} {} take {} bytes; an HDF5 chunk (one "
+                                  "frame) holds at most {}",
+                                  file.string(), c.id, c.width, c.height, to_string(c.pixel_format), frame_bytes,
+                                  layout::kMaxFrameBytes));
   }
 }
 
+
+// A "<path>.partial" that exists before this writer starts was left by a writer that never
+// finished: a live recording keeps every set it flushed there. It is evidence, never replaced.
+[[noreturn]] void refuse_left_over_partial(const fs::path& partial, const fs::path& final_path) {
+  const std::string p = partial.string();
+  const fs::path kept = fs::path(final_path).replace_extension("").concat("-recovered").concat(
+      final_path.extension().string());
+  throw bad_input(fmt::format(
+      "'{}' already exists: an earlier recording into '{}' did not finish (it was killed, crashed or lost power) and "
+      "may hold recorded sets, so tomorig never replaces it, not even with --overwrite. See what it holds: "
+      "tomorig inspect '{}'. To keep it: mv '{}' '{}' (other HDF5 tools may then need: h5clear -s '{}'). To "
+      "discard it: rm '{}'. Then run again.",
+      p, final_path.string(), p, p, kept.string(), kept.string(), p));
+}
 
 std::string describe_image(const Image& image) {
   return fmt::format("{} x {} {}", image.width(), image.height(), to_string(image.type()));
@@ -95,7 +118,9 @@ struct SessionWriter::Impl {
   void complete_live_file();
 
   // Declaration order matters: members are destroyed in reverse, so every dataset is closed,
-  // then the file, and only then does `partial` delete the file if it was not finished.
+  // then the file, then `partial` deletes the file if it was not finished, and only then is
+  // the name unlocked for another writer.
+  OutputLock lock;
   PartialFile partial;
   fs::path final_path;
   SessionWriterOptions options;
@@ -127,6 +152,9 @@ SessionWriter::Impl::Impl(const fs::path& path, const SessionInfo& info, const S
     : partial(fs::path(path).concat(".partial")), final_path(path), options(opts) {
   check_cameras(info.cameras, final_path);
   check_output_path(final_path, options.overwrite, "session");
+  lock = OutputLock::acquire(final_path, "session");
+  std::error_code ec;
+  if (fs::exists(fs::symlink_status(partial.path(), ec))) refuse_left_over_partial(partial.path(), final_path);
   if (options.compression != Compression::none)
     require_filter(kBitshuffleFilterId, fmt::format("writing session '{}' with {} compression", final_path.string(),
                                                     to_string(options.compression)));
@@ -139,7 +167,8 @@ SessionWriter::Impl::Impl(const fs::path& path, const SessionInfo& info, const S
   if (options.live)
     h5::check(H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_LATEST, H5F_LIBVER_LATEST), "cannot configure",
               "a file access list");
-  const hid_t id = H5Fcreate(partial.path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get());
+  // EXCL: even if something created the partial file since the check above, it is not truncated.
+  const hid_t id = H5Fcreate(partial.path().c_str(), H5F_ACC_EXCL, H5P_DEFAULT, fapl.get());
   if (id < 0)
     throw bad_input(fmt::format("cannot create session file '{}' (is folder '{}' writable?): {}",
                                 partial.path().string(), partial.path().parent_path().string(),
@@ -169,20 +198,21 @@ SessionWriter::Impl::Impl(const fs::path& path, const SessionInfo& info, const S
 
 void SessionWriter::Impl::create_layout(const SessionInfo& info) {
   const hid_t root = file.get();
-  h5::write_string_attr(root, layout::kAttrFormat, layout::kFormatName, "/");
+  // Format version 2: every string fixed-length (see session_layout.h).
+  h5::write_fixed_string_attr(root, layout::kAttrFormat, layout::kFormatName, "/");
   h5::write_int_attr(root, layout::kAttrFormatVersion, layout::kFormatVersion, H5T_STD_I32LE, "/");
-  h5::write_string_attr(root, layout::kAttrSoftwareVersion,
-                        info.software_version.empty() ? software_version() : info.software_version, "/");
-  h5::write_string_attr(root, layout::kAttrCreatedUtc,
-                        info.created_utc.empty() ? utc_now_iso8601() : info.created_utc, "/");
-  h5::write_string_attr(root, layout::kAttrCompression, to_string(options.compression), "/");
+  h5::write_fixed_string_attr(root, layout::kAttrSoftwareVersion,
+                              info.software_version.empty() ? software_version() : info.software_version, "/");
+  h5::write_fixed_string_attr(root, layout::kAttrCreatedUtc,
+                              info.created_utc.empty() ? utc_now_iso8601() : info.created_utc, "/");
+  h5::write_fixed_string_attr(root, layout::kAttrCompression, to_string(options.compression), "/");
   if (options.live) h5::write_int_attr(root, layout::kAttrRecordingComplete, 0, H5T_STD_I32LE, "/");
-  h5::write_string_dataset(root, layout::kConfig, info.rig_config_toml, "/config");
+  h5::write_fixed_string_dataset(root, layout::kConfig, info.rig_config_toml, "/config");
 
   h5::Group cameras = h5::create_group(root, layout::kCameras, "/cameras");
   std::vector<std::string> order;
   for (const auto& c : info.cameras) order.push_back(c.id);
-  h5::write_string_list_attr(cameras.get(), layout::kAttrOrder, order, "/cameras");
+  h5::write_fixed_string_list_attr(cameras.get(), layout::kAttrOrder, order, "/cameras");
   for (std::size_t i = 0; i < info.cameras.size(); ++i) create_camera(info.cameras[i], i, cameras.get());
   create_set_datasets();
 }
@@ -192,7 +222,7 @@ void SessionWriter::Impl::create_camera(const SessionCamera& camera, std::size_t
   h5::Group group = h5::create_group(cameras_group, camera.id.c_str(), where);
   h5::write_int_attr(group.get(), layout::kAttrWidth, camera.width, H5T_STD_I32LE, where);
   h5::write_int_attr(group.get(), layout::kAttrHeight, camera.height, H5T_STD_I32LE, where);
-  h5::write_string_attr(group.get(), layout::kAttrPixelFormat, to_string(camera.pixel_format), where);
+  h5::write_fixed_string_attr(group.get(), layout::kAttrPixelFormat, to_string(camera.pixel_format), where);
   h5::write_double_attr(group.get(), layout::kAttrPixelPitch, camera.pixel_pitch_um, where);
   h5::write_int_attr(group.get(), layout::kAttrIndex, static_cast<std::int64_t>(index), H5T_STD_I32LE, where);
 
@@ -424,22 +454,22 @@ void SessionWriter::write_truth(const SessionTruth& truth) {
 
 void SessionWriter::Impl::store_truth(const SessionTruth& truth) {
   h5::Group group = ensure_group(file.get(), layout::kTruth, "/truth");
-  h5::write_string_attr(group.get(), layout::kAttrCase, truth.case_name, "/truth");
-  h5::write_string_attr(group.get(), layout::kAttrFlow, truth.flow_name, "/truth");
-  h5::write_string_attr(group.get(), layout::kAttrFlowParameters, truth.flow_parameters, "/truth");
+  h5::write_fixed_string_attr(group.get(), layout::kAttrCase, truth.case_name, "/truth");
+  h5::write_fixed_string_attr(group.get(), layout::kAttrFlow, truth.flow_name, "/truth");
+  h5::write_fixed_string_attr(group.get(), layout::kAttrFlowParameters, truth.flow_parameters, "/truth");
   h5::write_uint64_attr(group.get(), layout::kAttrSeed, truth.seed, "/truth");
   h5::write_double_attr(group.get(), layout::kAttrPpp, truth.ppp, "/truth");
 
   h5::Group cameras = ensure_group(group.get(), layout::kCameras, "/truth/cameras");
   std::vector<std::string> order;
   for (const auto& c : truth.cameras) order.push_back(c.id);
-  h5::write_string_list_attr(cameras.get(), layout::kAttrOrder, order, "/truth/cameras");
+  h5::write_fixed_string_list_attr(cameras.get(), layout::kAttrOrder, order, "/truth/cameras");
   const hsize_t mat_dims[2] = {3, 3};
   const hsize_t vec_dims[1] = {3};
   for (const auto& c : truth.cameras) {
     const std::string where = "/truth/cameras/" + c.id;
     h5::Group g = h5::create_group(cameras.get(), c.id.c_str(), where);
-    h5::write_string_attr(g.get(), layout::kAttrModel, c.model, where);
+    h5::write_fixed_string_attr(g.get(), layout::kAttrModel, c.model, where);
     h5::write_doubles_attr(g.get(), layout::kAttrK, c.K, mat_dims, where);
     h5::write_doubles_attr(g.get(), layout::kAttrR, c.R, mat_dims, where);
     const std::array<double, 3> t{c.t.x, c.t.y, c.t.z};
@@ -534,6 +564,7 @@ void SessionWriter::finish() {
   }
   m.partial.release();
   m.finished = true;
+  m.lock = OutputLock();  // the file is complete under its name: another writer may now replace it
 }
 
 std::uint64_t SessionWriter::sets_written() const { return impl_->sets; }

@@ -14,6 +14,7 @@
 #include "h5_error.h"
 #include "h5_handle.h"
 #include "h5_open.h"
+#include "isolated_probe.h"
 #include "tomorig/core/error.h"
 #include "tomorig/storage/volume_file.h"
 #include "volume_layout.h"
@@ -108,7 +109,12 @@ StoredVolume VolumeFileReader::Impl::read_volume(const std::string& name) const 
   return v;
 }
 
-VolumeFileReader::VolumeFileReader(const fs::path& path) : impl_(std::make_unique<Impl>(path)) {}
+VolumeFileReader::VolumeFileReader(const fs::path& path) {
+  h5::silence_errors();
+  // The open pass runs in a child first: a library crash on a damaged file ends only the child.
+  require_safe_to_read([&] { const Impl probe(path); }, "volume file", path);
+  impl_ = std::make_unique<Impl>(path);
+}
 VolumeFileReader::~VolumeFileReader() = default;
 
 const VolumeFileInfo& VolumeFileReader::info() const { return impl_->info; }

@@ -15,6 +15,7 @@
 #include "h5_error.h"
 #include "h5_handle.h"
 #include "output_path.h"
+#include "output_lock.h"
 #include "partial_file.h"
 #include "tomorig/core/error.h"
 #include "tomorig/core/version.h"
@@ -70,6 +71,7 @@ struct VolumeFileWriter::Impl {
   void write_dense(hid_t group, const std::string& where, const VoxelGrid& grid, FillSlice&& fill_slice);
   [[noreturn]] void fail(const std::string& action, const h5::Failure& failure);
 
+  OutputLock lock;  // first declared, last released: after `partial` removed an unfinished file
   fs::path final_path;
   VolumeFileOptions options;
   PartialFile partial;
@@ -85,6 +87,9 @@ VolumeFileWriter::Impl::Impl(const fs::path& path, const VolumeFileInfo& info, c
     : final_path(path), options(opts), partial(fs::path(path).concat(".partial")) {
   h5::silence_errors();
   check_output_path(final_path, options.overwrite, "volume");
+  // A volume's partial file holds nothing until finish(), so one left by a killed writer is
+  // replaced; the lock keeps a running writer's file from being replaced.
+  lock = OutputLock::acquire(final_path, "volume");
   const fs::path sidecar = VolumeFileWriter::sidecar_path(final_path);
   std::error_code ec;
   if (fs::exists(sidecar, ec) && !options.overwrite)
@@ -275,6 +280,7 @@ void VolumeFileWriter::finish() {
                                           m.final_path.string(), ec.message()));
   m.partial.release();
   m.finished = true;
+  m.lock = OutputLock();  // done: the name is free for another writer
 }
 
 }  // namespace tomorig::storage

@@ -8,8 +8,9 @@
 #include <fmt/format.h>
 
 #include "byte_io.h"
-#include "wire_preamble.h"
+#include "tomorig/core/camera_id.h"
 #include "tomorig/core/error.h"
+#include "wire_preamble.h"
 
 namespace tomorig::stream {
 namespace {
@@ -229,7 +230,7 @@ FrameSet decode_frame_set(std::vector<zmq::message_t>&& parts) {
     if (r.offset() + length > table_start + table_bytes)
       throw bad_input("camera id runs past the end of the id table");
     cam.camera_id = r.string(length, "camera_id");
-    if (cam.camera_id.empty()) throw bad_input("wire header has an empty camera id");
+    require_valid_camera_id(cam.camera_id, "wire header");  // UTF-8, no '/', NUL or escapes (core/camera_id.h)
   }
   if (r.offset() != table_start + table_bytes)
     throw bad_input(fmt::format("camera id table declares {} bytes but its ids fill {}", table_bytes,

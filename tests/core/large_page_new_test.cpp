@@ -2,6 +2,7 @@
 // boundary and, where the kernel offers transparent huge pages, are backed by them; small ones
 // and every kind of delete keep working.
 #include <gtest/gtest.h>
+#include <malloc.h>
 
 #include <cstdint>
 #include <cstdio>
@@ -68,6 +69,23 @@ TEST(LargePageNew, SmallAndArrayAndNothrowAllocationsRoundTrip) {
   void* zero = ::operator new(0);
   EXPECT_NE(zero, nullptr);
   ::operator delete(zero, std::size_t{0});
+}
+
+// aligned_alloc wants a size that is a multiple of its 2 MiB alignment (issue 14, defect 8:
+// sanitizers abort otherwise): every large buffer gets whole huge pages, the same pages the
+// huge-page advice covers, and a size that cannot be rounded up fails as bad_alloc.
+TEST(LargePageNew, LargeBuffersAreWholeHugePages) {
+  for (const std::size_t bytes : {std::size_t{1} << 20, (std::size_t{2} << 20) + 1, (std::size_t{3} << 20) + 123,
+                                  (std::size_t{5} << 20) + 7, (std::size_t{9} << 20) + 4095}) {
+    void* p = ::operator new(bytes);
+    const std::size_t whole_pages = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(p) % kHugePage, 0u) << bytes;
+    EXPECT_GE(malloc_usable_size(p), whole_pages) << bytes << " bytes";
+    ::operator delete(p);
+  }
+  volatile std::size_t huge = SIZE_MAX - 5;  // volatile: no compile-time "too large" diagnosis
+  EXPECT_THROW(static_cast<void>(::operator new(huge)), std::bad_alloc);
+  EXPECT_EQ(::operator new(huge, std::nothrow), nullptr);
 }
 
 }  // namespace

@@ -120,13 +120,15 @@ TEST(ResultsFile, ResumesFinishedSetsAndRefusesAnotherSession) {
   ResultsWriter(path, info()).add(set_with(0, 1.0f));
   const std::string stamp = ResultsReader(path).read_set(0).completed_utc;
 
-  ResultsWriter resumed(path, info());
-  EXPECT_EQ(resumed.resumed_sets(), 1u);
-  EXPECT_TRUE(resumed.has_set(0));
-  EXPECT_FALSE(resumed.has_set(1));
-  EXPECT_THROW(resumed.add(set_with(0, 2.0f)), Error);  // already there
-  resumed.add(set_with(1, 2.0f));
-  EXPECT_EQ(ResultsReader(path).read_set(0).completed_utc, stamp);  // kept, not recomputed
+  {
+    ResultsWriter resumed(path, info());
+    EXPECT_EQ(resumed.resumed_sets(), 1u);
+    EXPECT_TRUE(resumed.has_set(0));
+    EXPECT_FALSE(resumed.has_set(1));
+    EXPECT_THROW(resumed.add(set_with(0, 2.0f)), Error);  // already there
+    resumed.add(set_with(1, 2.0f));
+    EXPECT_EQ(ResultsReader(path).read_set(0).completed_utc, stamp);  // kept, not recomputed
+  }  // one writer per file: the next ones open it after this one is done
 
   try {
     ResultsWriter other(path, info("session-2"));

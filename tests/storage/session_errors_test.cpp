@@ -88,8 +88,9 @@ TEST(SessionReaderErrors, UnsupportedFormatVersion) {
   TempDir dir;
   const fs::path path = dir / "future.h5";
   write_test_session(path, kCameras, 1);
-  RawFile(path).set_int_attr("/", "format_version", 2);
-  expect_error([&] { SessionReader r(path); }, ErrorKind::bad_input, {path.string(), "format version 2"});
+  RawFile(path).set_int_attr("/", "format_version", 3);
+  expect_error([&] { SessionReader r(path); }, ErrorKind::bad_input,
+               {path.string(), "format version 3", "reads versions 1 to 2"});
 }
 
 TEST(SessionReaderErrors, FramesDisagreeWithCameraSize) {

@@ -99,7 +99,7 @@ TEST_P(RoundTrip, EverythingReadsBackBitIdentical) {
   ASSERT_TRUE(fs::exists(path));
 
   SessionReader reader(path);
-  EXPECT_EQ(reader.format_version(), 1);
+  EXPECT_EQ(reader.format_version(), 2);
   EXPECT_EQ(reader.info().rig_config_toml, info.rig_config_toml);
   EXPECT_EQ(reader.info().compression, compression);
   EXPECT_FALSE(reader.info().software_version.empty());

@@ -322,6 +322,26 @@ TEST_F(BadMessage, BadFrameEntries) {
   expect_rejected(header_, {"marked missing"});
 }
 
+// Issue 14, defect 5: ids that cannot name a camera (a path, a non-UTF-8 byte, a NUL, an escape
+// sequence) are refused by the decoder with the id escaped, never stored or echoed raw.
+TEST_F(BadMessage, CameraIdsThatAreNotValidIds) {
+  using namespace std::string_literals;
+  for (const std::string& id : {"a/b"s, ".."s, "\xff"s, "a\0b"s, "cam\x1b[2J"s}) {
+    FrameSet set = set_;
+    set.cameras[1].camera_id = id;
+    try {
+      decode_frame_set(encode_frame_set(set));
+      ADD_FAILURE() << "accepted camera id " << ::testing::PrintToString(id);
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::bad_input);
+      const std::string message = e.what();
+      EXPECT_NE(message.find("wire header: camera id"), std::string::npos) << message;
+      EXPECT_NE(message.find("is not allowed"), std::string::npos) << message;
+      EXPECT_EQ(message.find('\x1b'), std::string::npos) << "raw escape byte in the message";
+    }
+  }
+}
+
 TEST_F(BadMessage, ReservedBytesMustBeZero) {
   header_[entries_ + 5] = std::byte{1};
   expect_rejected(header_, {"reserved"});

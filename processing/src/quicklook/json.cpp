@@ -101,4 +101,31 @@ void to_json(nlohmann::json& j, const DriftReport& r) {
        {"flag", r.flag}};
 }
 
+void to_json(nlohmann::json& j, const SheetProfile& s) {
+  nlohmann::json profile = nlohmann::json::array();
+  for (const double v : s.intensity) profile.push_back(number(v));
+  j = {{"found", s.found},
+       {"position_mm", number(s.position_mm)},
+       {"thickness_mm", number(s.thickness_mm)},
+       {"low_edge_mm", number(s.low_edge_mm)},
+       {"high_edge_mm", number(s.high_edge_mm)},
+       {"ghost_front", number(s.ghost_front)},
+       {"ghost_back", number(s.ghost_back)},
+       {"rsnr", number(s.rsnr)},
+       {"flag", s.flag},
+       {"z0_mm", s.z_mm.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.z_mm.front())},
+       {"dz_mm", s.z_mm.size() < 2 ? nlohmann::json(nullptr) : nlohmann::json(s.z_mm[1] - s.z_mm[0])},
+       {"profile", std::move(profile)}};
+}
+
+void to_json(nlohmann::json& j, const PreviewResult& r) {
+  const VoxelGrid& g = r.grid;
+  j = {{"grid",
+        {{"nx", g.nx}, {"ny", g.ny}, {"nz", g.nz}, {"voxel_mm", g.voxel_size}, {"origin_mm", point(g.origin)}}},
+       {"active_voxels", r.active_voxels},
+       {"reconstruction_seconds", r.reconstruction_seconds},
+       {"seconds", r.seconds},
+       {"sheet", r.sheet}};
+}
+
 }  // namespace tomorig::quicklook

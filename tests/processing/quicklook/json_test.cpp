@@ -76,5 +76,34 @@ TEST(QuickLookJson, DtCheckResult) {
   EXPECT_TRUE(j["windows"][0]["valid"].get<bool>());
 }
 
+TEST(QuickLookJson, SheetProfile) {
+  // Ghost 0.25 around a flat sheet over slices 10 to 19, one slice nobody sees.
+  std::vector<double> p(40, 0.5);
+  for (int k = 10; k < 20; ++k) p[static_cast<std::size_t>(k)] = 2.0;
+  p[39] = std::nan("");
+  const SheetProfile s = analyse_depth_profile(p, -2.0, 0.1);
+  const nlohmann::json j = nlohmann::json::parse(nlohmann::json(s).dump());
+  EXPECT_TRUE(j["found"].get<bool>());
+  EXPECT_NEAR(j["thickness_mm"].get<double>(), 1.0, 1e-9);
+  EXPECT_NEAR(j["position_mm"].get<double>(), -2.0 + 1.45, 1e-9);
+  EXPECT_NEAR(j["ghost_front"].get<double>(), 0.25, 1e-9);
+  EXPECT_NEAR(j["rsnr"].get<double>(), 4.0, 1e-9);
+  EXPECT_EQ(j["flag"], "green");
+  EXPECT_DOUBLE_EQ(j["z0_mm"].get<double>(), -2.0);
+  EXPECT_NEAR(j["dz_mm"].get<double>(), 0.1, 1e-12);
+  ASSERT_EQ(j["profile"].size(), 40u);
+  EXPECT_DOUBLE_EQ(j["profile"][10].get<double>(), 1.0);
+  EXPECT_TRUE(j["profile"][39].is_null());
+
+  PreviewResult r;
+  r.grid = VoxelGrid::centred(4, 5, 40, 0.1);
+  r.sheet = s;
+  r.active_voxels = 7;
+  const nlohmann::json pr = nlohmann::json::parse(nlohmann::json(r).dump());
+  EXPECT_EQ(pr["grid"]["ny"], 5);
+  EXPECT_EQ(pr["active_voxels"], 7);
+  EXPECT_EQ(pr["sheet"]["profile"].size(), 40u);
+}
+
 }  // namespace
 }  // namespace tomorig::quicklook

@@ -98,7 +98,9 @@ class ResultsWriter {
   // A new file, or resumes an existing one: then its finished sets are kept (has_set()) and
   // the statistics rebuilt, reading one set at a time. Throws tomorig::Error (bad_input) if the
   // existing file is not a results file, belongs to another session (different identity) or was
-  // made with different parameters; or if the folder is missing or the path is a folder.
+  // made with different parameters; or if the folder is missing or the path is a folder; or if
+  // another writer (in this or another process) has the file: a writer holds the file's lock
+  // ("<path>.lock", see docs/file-formats.md) from construction to destruction.
   // Nothing is written before write() or the first add(), except that a version-1 file is
   // converted to version 2 at once; a file left by a killed writer is copied at the first add().
   ResultsWriter(const std::filesystem::path& path, const ResultsInfo& info, const ResultsWriterOptions& options = {});

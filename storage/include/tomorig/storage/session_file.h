@@ -99,7 +99,10 @@ class DiskFullError : public Error {
 
 struct SessionWriterOptions {
   Compression compression = Compression::none;
-  bool overwrite = false;  // replace an existing file at the final path
+  // Replace an existing file at the final path. Never a left-over "<path>.partial": that is
+  // what a writer that did not finish left behind (a live one's recorded sets), and the
+  // constructor refuses to start while it exists.
+  bool overwrite = false;
   // Live recording (the recorder of a running rig): the file is written with HDF5 SWMR, so
   // `tomorig inspect <path>.partial` reads it while it grows, it is flushed by `flush`, and a
   // writer abandoned without finish() (a full disk, Ctrl-C, a crash) keeps "<path>.partial"
@@ -117,8 +120,10 @@ struct SessionWriterOptions {
 
 class SessionWriter {
  public:
-  // Creates "<path>.partial". Throws tomorig::Error (bad_input) if the folder is not
-  // writable or the file exists and overwrite is false.
+  // Locks the name for this writer (see "One writer per file" in docs/file-formats.md) and
+  // creates "<path>.partial". Throws tomorig::Error (bad_input), having changed nothing, if
+  // the folder is not writable, the file exists and overwrite is false, another writer holds
+  // the name, or "<path>.partial" exists (the message gives the commands to recover it).
   SessionWriter(const std::filesystem::path& path, const SessionInfo& info,
                 const SessionWriterOptions& options = {});
   ~SessionWriter();  // without finish(): closes and removes the partial file
@@ -148,8 +153,12 @@ class SessionWriter {
 
 class SessionReader {
  public:
-  // Opens and validates the layout. Throws tomorig::Error (bad_input) naming the file and
-  // what is wrong: missing, not HDF5, not a tomorig session, wrong sizes, truncated datasets.
+  // Opens and validates the layout, types and declared sizes before reading anything (see
+  // "Reading safely" in docs/file-formats.md). Throws tomorig::Error (bad_input) naming the
+  // file and what is wrong: missing, not HDF5, not a tomorig session, wrong sizes or types,
+  // truncated datasets, damaged. The open pass runs first in a forked child process, so a
+  // libhdf5 crash or endless loop on a damaged file ends the child, not the caller: open
+  // readers before starting threads that use HDF5 (a child may inherit a lock they hold).
   explicit SessionReader(const std::filesystem::path& path);
   ~SessionReader();
   SessionReader(const SessionReader&) = delete;

@@ -7,6 +7,7 @@
 
 #include "tomorig/processing/quicklook/drift_monitor.h"
 #include "tomorig/processing/quicklook/dt_check.h"
+#include "tomorig/processing/quicklook/preview_volume.h"
 #include "tomorig/processing/quicklook/statistics.h"
 
 namespace tomorig::quicklook {
@@ -18,5 +19,9 @@ void to_json(nlohmann::json& j, const FrameStatistics& s);
 void to_json(nlohmann::json& j, const CameraQuickLook& s);
 void to_json(nlohmann::json& j, const DtCheckResult& r);
 void to_json(nlohmann::json& j, const DriftReport& r);
+void to_json(nlohmann::json& j, const SheetProfile& s);
+// The numbers of a preview (grid, sheet, profile, timings); the volume and projections are not
+// JSON (the preview stream sends the projections as images).
+void to_json(nlohmann::json& j, const PreviewResult& r);
 
 }  // namespace tomorig::quicklook
