@@ -376,9 +376,9 @@ void SessionReader::Impl::read_sets() {
   for (std::uint64_t s = 0; s < sets; ++s) {
     const auto first = frame_present.begin() + static_cast<std::ptrdiff_t>(s * per_set);
     for (std::size_t k = 0; k < per_set; ++k)
-      if (first[static_cast<std::ptrdiff_t>(k)] > 1)
-        corrupt(fmt::format("/sets/frame_present of set {}, camera {}, frame {} is {}; it must be 0 (missing) or 1 "
-                            "(present)",
+      if (first[static_cast<std::ptrdiff_t>(k)] > 2)
+        corrupt(fmt::format("/sets/frame_present of set {}, camera {}, frame {} is {}; it must be 0 (missing), 1 "
+                            "(present) or 2 (present, from a free-running camera)",
                             s, info.cameras[k / 2].id, k % 2 == 0 ? 'A' : 'B', first[static_cast<std::ptrdiff_t>(k)]));
     const auto lost = std::count(first, first + static_cast<std::ptrdiff_t>(per_set), std::uint8_t{0});
     // 2: a free-running camera's frame, present but not of this event: the set is not complete.
@@ -395,7 +395,8 @@ void SessionReader::Impl::check_frame_storage() {
   const std::size_t n = cameras.size();
   for (std::size_t c = 0; c < n; ++c) {
     std::uint64_t present = 0;
-    for (std::uint64_t s = 0; s < sets; ++s) present += frame_present[(s * n + c) * 2] + frame_present[(s * n + c) * 2 + 1];
+    for (std::uint64_t s = 0; s < sets; ++s)
+      present += (frame_present[(s * n + c) * 2] != 0 ? 1 : 0) + (frame_present[(s * n + c) * 2 + 1] != 0 ? 1 : 0);
     const SessionCamera& camera = info.cameras[c];
     const std::uint64_t frame_bytes = static_cast<std::uint64_t>(camera.width) * camera.height *
                                       bytes_per_sample(cameras[c].sample_type);

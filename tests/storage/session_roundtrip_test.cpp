@@ -351,3 +351,37 @@ TEST(Compression, NamesRoundTrip) {
 
 }  // namespace
 }  // namespace tomorig::storage
+
+namespace tomorig::storage {
+namespace {
+
+// frame_present = 2: a free-running camera's frame is kept, and its set is not complete.
+TEST(SessionRoundTrip, AnUnsynchronisedFrameIsKeptAndItsSetIsIncomplete) {
+  tomorig::testing::TempDir dir;
+  const auto path = dir / "free.h5";
+  const std::vector<SessionCamera> cameras = {test_camera("cam0", 8, 6, PixelFormat::Mono16),
+                                              test_camera("cam1", 8, 6, PixelFormat::Mono16)};
+  SessionInfo info;
+  info.cameras = cameras;
+  {
+    SessionWriter writer(path, info, {});
+    FrameSet set = test_set(cameras, 0);
+    set.cameras[1].a.synchronised = false;
+    set.cameras[1].b.synchronised = false;
+    writer.append(set);
+    writer.append(test_set(cameras, 1));
+    writer.finish();
+  }
+  const SessionReader reader(path);
+  EXPECT_EQ(reader.missing_frames(), 0);
+  EXPECT_EQ(reader.incomplete_sets(), 1);
+  const FrameSet back = reader.read_set(0);
+  EXPECT_TRUE(back.cameras[1].a.present());
+  EXPECT_FALSE(back.cameras[1].a.synchronised);
+  EXPECT_FALSE(back.complete());
+  EXPECT_TRUE(reader.read_set(1).complete());
+  EXPECT_FALSE(reader.set_record(0).frame_synchronised[1][0]);
+}
+
+}  // namespace
+}  // namespace tomorig::storage

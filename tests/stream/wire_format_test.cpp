@@ -349,3 +349,22 @@ TEST_F(BadMessage, ReservedBytesMustBeZero) {
 
 }  // namespace
 }  // namespace tomorig::stream
+
+namespace tomorig::stream {
+namespace {
+
+// A free-running camera's frame crosses the stream still marked as not of its set's event.
+TEST(WireFormat, AnUnsynchronisedFrameStaysFlagged) {
+  FrameSet set = pattern_set(3, 2, 8, 6, SampleType::u16);
+  set.cameras[1].b.synchronised = false;
+  ASSERT_FALSE(set.complete());
+  const FrameSet back = decode_frame_set(encode_frame_set(set));
+  expect_same_set(back, set);
+  EXPECT_TRUE(back.cameras[1].b.present());
+  EXPECT_FALSE(back.cameras[1].b.synchronised);
+  EXPECT_TRUE(back.cameras[1].a.synchronised);
+  EXPECT_FALSE(back.complete());
+}
+
+}  // namespace
+}  // namespace tomorig::stream
