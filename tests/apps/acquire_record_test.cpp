@@ -63,7 +63,7 @@ TEST(AcquireRecord, SplitRigRecordsFramesBitIdenticalToTheSimulator) {
   const std::string endpoint = endpoint_from(*line);
   ASSERT_FALSE(endpoint.empty()) << *line;
 
-  TomorigProcess record({"record", "--from", endpoint, "-o", recorded.string(), "--sets", "3", "--idle-timeout", "30"});
+  TomorigProcess record({"record", "--from", endpoint, "-o", recorded.string(), "--idle-timeout", "30"});
   ASSERT_EQ(record.wait(), 0) << record.err();
   ASSERT_EQ(acquire.wait(), 0) << acquire.err();
   EXPECT_NE(acquire.out().find("acquired and sent 3 sets"), std::string::npos) << acquire.out();
@@ -111,7 +111,7 @@ TEST(AcquireRecord, VanishedCameraIsCountedAndRecordedAsMissing) {
   const auto line = acquire.wait_for_line("acquire: sending on");
   ASSERT_TRUE(line) << acquire.err();
   TomorigProcess record(
-      {"record", "--from", endpoint_from(*line), "-o", recorded.string(), "--sets", "4", "--idle-timeout", "30"});
+      {"record", "--from", endpoint_from(*line), "-o", recorded.string(), "--idle-timeout", "30"});
   ASSERT_EQ(record.wait(), 0) << record.err();
   ASSERT_EQ(acquire.wait(), 0) << acquire.err();
   EXPECT_NE(acquire.err().find("camera cam2 vanished at trigger 2"), std::string::npos) << acquire.err();

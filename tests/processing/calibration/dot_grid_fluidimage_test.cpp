@@ -25,9 +25,9 @@ using tomorig::calibration::PointCorrespondence;
 
 fs::path sample_dir() {
   if (const char* env = std::getenv("TOMORIG_FLUIDIMAGE_DIR")) return env;
-  // tests/processing/calibration/ -> the project root -> ../shared/data
-  return fs::path(__FILE__).parent_path().parent_path().parent_path().parent_path().parent_path() / "shared" / "data" /
-         "fluidimage-tomopiv";
+  // ../shared/data beside the checkout, as the build names it (__FILE__ is relative to the build
+  // folder under Ninja, so it cannot locate the checkout).
+  return fs::path(TOMORIG_SHARED_DIR) / "data" / "fluidimage-tomopiv";
 }
 
 TEST(DotGridFluidimage, EveryCameraAndPlaneDetectsAndFits) {
