@@ -16,6 +16,7 @@
 #include "h5_error.h"
 #include "h5_handle.h"
 #include "h5_open.h"
+#include "quicklook_rows.h"
 #include "session_layout.h"
 #include "tomorig/core/error.h"
 #include "tomorig/storage/session_file.h"
@@ -438,6 +439,67 @@ TruthSet SessionReader::truth_set(std::uint64_t set_index) const {
     m.corrupt(failure.what());
   }
   return truth;
+}
+
+std::vector<QuickLookRecord> SessionReader::quicklook() const {
+  h5::silence_errors();
+  const Impl& m = *impl_;
+  std::vector<QuickLookRecord> records;
+  if (!h5::link_exists(m.file.get(), layout::kQuickLook)) return records;
+  try {
+    h5::Group group = h5::open_group(m.file.get(), layout::kQuickLook, "/quicklook");
+    struct Table {
+      h5::Dataset dataset;
+      std::vector<hsize_t> dims;
+      std::vector<std::string> columns;
+    };
+    auto open = [&](const char* name, std::size_t rank, bool with_columns) {
+      const std::string where = layout::quicklook_path(name);
+      if (!h5::link_exists(group.get(), name)) m.invalid(fmt::format("{} is missing", where));
+      Table t{h5::open_dataset(group.get(), name, where), {}, {}};
+      t.dims = h5::dims_of(t.dataset.get(), where);
+      if (t.dims.size() != rank) m.invalid(fmt::format("{} has {} dimensions, not {}", where, t.dims.size(), rank));
+      if (with_columns) {
+        t.columns = h5::read_string_list_attr(t.dataset.get(), layout::kAttrColumns, where);
+        if (t.columns.size() != t.dims.back())
+          m.invalid(fmt::format("{} has {} columns but {} column names", where, t.dims.back(), t.columns.size()));
+      }
+      return t;
+    };
+    Table index = open(layout::kQuickLookSetIndex, 1, false);
+    Table sets = open(layout::kQuickLookSets, 2, true);
+    Table cameras = open(layout::kQuickLookCameras, 3, true);
+    if (cameras.dims[1] != m.cameras.size())
+      m.invalid(fmt::format("/quicklook/cameras holds {} cameras but the session has {}", cameras.dims[1],
+                            m.cameras.size()));
+    // The set index is written last: it says how many rows are whole (a live file may hold the
+    // start of the next one in the tables).
+    const hsize_t rows = std::min({index.dims[0], sets.dims[0], cameras.dims[0]});
+    if (rows == 0) return records;
+    std::vector<std::uint64_t> set_index(index.dims[0]);
+    h5::read_all(index.dataset.get(), H5T_NATIVE_UINT64, set_index.data(), "/quicklook/set_index");
+    std::vector<float> set_values(sets.dims[0] * sets.dims[1]);
+    h5::read_all(sets.dataset.get(), H5T_NATIVE_FLOAT, set_values.data(), "/quicklook/sets");
+    std::vector<float> camera_values(cameras.dims[0] * cameras.dims[1] * cameras.dims[2]);
+    h5::read_all(cameras.dataset.get(), H5T_NATIVE_FLOAT, camera_values.data(), "/quicklook/cameras");
+
+    const std::vector<int> set_positions = detail::column_positions(quicklook_set_columns(), sets.columns);
+    const std::vector<int> camera_positions = detail::column_positions(quicklook_camera_columns(), cameras.columns);
+    const std::size_t set_width = sets.dims[1], camera_width = cameras.dims[2], n_cams = cameras.dims[1];
+    records.resize(rows);
+    for (std::size_t r = 0; r < rows; ++r) {
+      QuickLookRecord& record = records[r];
+      record.set_index = set_index[r];
+      detail::read_set_row(std::span(set_values).subspan(r * set_width, set_width), set_positions, record);
+      record.cameras.resize(n_cams);
+      for (std::size_t c = 0; c < n_cams; ++c)
+        detail::read_camera_row(std::span(camera_values).subspan((r * n_cams + c) * camera_width, camera_width),
+                                camera_positions, record.cameras[c]);
+    }
+  } catch (const h5::Failure& failure) {
+    m.corrupt(failure.what());
+  }
+  return records;
 }
 
 }  // namespace tomorig::storage
