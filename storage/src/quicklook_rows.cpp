@@ -120,5 +120,37 @@ void read_camera_row(std::span<const float> row, const std::vector<int>& positio
     if (positions[i] >= 0) columns[i].put(record, row[static_cast<std::size_t>(positions[i])]);
 }
 
+namespace {
+void take(float& into, float later) {
+  if (std::isfinite(later)) into = later;
+}
+}  // namespace
+
+void merge(QuickLookRecord& into, const QuickLookRecord& later) {
+  into.flag = std::max(into.flag, later.flag);
+  into.preview = into.preview || later.preview;
+  for (auto f : {&QuickLookRecord::sheet_position_mm, &QuickLookRecord::sheet_thickness_mm, &QuickLookRecord::ghost_front,
+                 &QuickLookRecord::ghost_back, &QuickLookRecord::rsnr})
+    take(into.*f, later.*f);
+  into.drift_alarms = std::max(into.drift_alarms, later.drift_alarms);
+  for (std::size_t c = 0; c < std::min(into.cameras.size(), later.cameras.size()); ++c) {
+    QuickLookCameraRecord& a = into.cameras[c];
+    const QuickLookCameraRecord& b = later.cameras[c];
+    a.flag = std::max(a.flag, b.flag);
+    for (int e = 0; e < 2; ++e) {
+      take(a.ppp[e], b.ppp[e]);
+      take(a.diameter_px[e], b.diameter_px[e]);
+      take(a.source_density[e], b.source_density[e]);
+      take(a.saturated_fraction[e], b.saturated_fraction[e]);
+      take(a.background[e], b.background[e]);
+      take(a.noise[e], b.noise[e]);
+      take(a.soft_tile_fraction[e], b.soft_tile_fraction[e]);
+    }
+    for (auto f : {&QuickLookCameraRecord::energy_balance, &QuickLookCameraRecord::dt_displacement_px,
+                   &QuickLookCameraRecord::dt_valid_fraction, &QuickLookCameraRecord::drift_px})
+      take(a.*f, b.*f);
+  }
+}
+
 }  // namespace detail
 }  // namespace tomorig::storage

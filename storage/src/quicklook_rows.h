@@ -20,4 +20,8 @@ std::vector<int> column_positions(const std::vector<std::string_view>& known, co
 void read_set_row(std::span<const float> row, const std::vector<int>& positions, QuickLookRecord& record);
 void read_camera_row(std::span<const float> row, const std::vector<int>& positions, QuickLookCameraRecord& record);
 
+// Folds a later row of the same set into `into`: measured figures replace unmeasured ones (and
+// the later of two measured ones wins), flags take the worse, preview and alarms add up.
+void merge(QuickLookRecord& into, const QuickLookRecord& later);
+
 }  // namespace tomorig::storage::detail

@@ -4,6 +4,7 @@
 #include <array>
 #include <cctype>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -486,16 +487,19 @@ std::vector<QuickLookRecord> SessionReader::quicklook() const {
     const std::vector<int> set_positions = detail::column_positions(quicklook_set_columns(), sets.columns);
     const std::vector<int> camera_positions = detail::column_positions(quicklook_camera_columns(), cameras.columns);
     const std::size_t set_width = sets.dims[1], camera_width = cameras.dims[2], n_cams = cameras.dims[1];
-    records.resize(rows);
+    std::map<std::uint64_t, QuickLookRecord> by_set;
     for (std::size_t r = 0; r < rows; ++r) {
-      QuickLookRecord& record = records[r];
-      record.set_index = set_index[r];
-      detail::read_set_row(std::span(set_values).subspan(r * set_width, set_width), set_positions, record);
-      record.cameras.resize(n_cams);
+      QuickLookRecord row;
+      row.set_index = set_index[r];
+      detail::read_set_row(std::span(set_values).subspan(r * set_width, set_width), set_positions, row);
+      row.cameras.resize(n_cams);
       for (std::size_t c = 0; c < n_cams; ++c)
         detail::read_camera_row(std::span(camera_values).subspan((r * n_cams + c) * camera_width, camera_width),
-                                camera_positions, record.cameras[c]);
+                                camera_positions, row.cameras[c]);
+      const auto [it, first] = by_set.try_emplace(row.set_index, row);
+      if (!first) detail::merge(it->second, row);
     }
+    for (auto& [index, record] : by_set) records.push_back(std::move(record));
   } catch (const h5::Failure& failure) {
     m.corrupt(failure.what());
   }

@@ -178,11 +178,49 @@ TEST(QuickLookStorage, OneGoWriterCreatesTheTablesOnFirstUseAndOlderSessionsHave
     writer.finish();
   }
   const auto rows = SessionReader(with).quicklook();
-  ASSERT_EQ(rows.size(), 2u);
-  expect_same(rows[0], record_for(7));
-  expect_same(rows[1], record_for(0));
+  ASSERT_EQ(rows.size(), 2u) << "one record per set, in set order";
+  expect_same(rows[0], record_for(0));
+  expect_same(rows[1], record_for(7));
   EXPECT_TRUE(SessionReader(without).quicklook().empty());
   EXPECT_FALSE(h5test::link_exists(without, "/quicklook")) << "no empty tables in sessions without a quick-look";
+}
+
+TEST(QuickLookStorage, RowsOfTheSameSetAreMerged) {
+  TempDir dir;
+  const fs::path path = dir.path() / "s.h5";
+  SessionWriter writer(path, info());
+  writer.append(test_set(kCameras, 0));
+  // Statistics first (no preview), the preview volume and drift of the same set later.
+  QuickLookRecord statistics = record_for(1);
+  statistics.flag = 0;
+  QuickLookRecord preview;
+  preview.set_index = 1;
+  preview.flag = 1;
+  preview.preview = true;
+  preview.sheet_position_mm = 0.25f;
+  preview.sheet_thickness_mm = 2.9f;
+  preview.drift_alarms = 2;
+  preview.cameras.resize(kCameras.size());
+  for (auto& c : preview.cameras) c.flag = 0;
+  preview.cameras[2].flag = 2;
+  preview.cameras[2].drift_px = 0.45f;
+  writer.append_quicklook(statistics);
+  writer.append_quicklook(record_for(4));
+  writer.append_quicklook(preview);
+  writer.finish();
+  const auto rows = SessionReader(path).quicklook();
+  ASSERT_EQ(rows.size(), 2u);
+  const QuickLookRecord& merged = rows[0];
+  EXPECT_EQ(merged.set_index, 1u);
+  EXPECT_EQ(merged.flag, 1) << "the worse of green and amber";
+  EXPECT_TRUE(merged.preview);
+  EXPECT_FLOAT_EQ(merged.sheet_position_mm, 0.25f);
+  EXPECT_EQ(merged.drift_alarms, 2);
+  EXPECT_FLOAT_EQ(merged.cameras[0].ppp[0], statistics.cameras[0].ppp[0]) << "statistics kept";
+  EXPECT_FLOAT_EQ(merged.cameras[2].drift_px, 0.45f);
+  EXPECT_EQ(merged.cameras[2].flag, 2);
+  EXPECT_FLOAT_EQ(merged.cameras[1].drift_px, 0.12f) << "a later unmeasured figure does not erase an earlier one";
+  expect_same(rows[1], record_for(4));
 }
 
 TEST(QuickLookStorage, TablesCarryTheirColumnNames) {

@@ -135,7 +135,8 @@ class SessionWriter {
   void write_truth_set(std::uint64_t set_index, const TruthSet& truth);
   // Quick-look numbers of one set (/quicklook, quicklook_record.h), e.g. from a quick-look
   // stage: safe to call from another thread while append() runs. Records may come late, skip
-  // sets and arrive out of order; each names its set. In a live recording they become visible
+  // sets and arrive out of order; each names its set, and several may name the same set (what
+  // is not measured in one is NaN there; quicklook() merges them). In a live recording they become visible
   // with the next flush. Throws bad_input for a record whose camera count is not the
   // session's; an HDF5 failure throws runtime, as append() does.
   void append_quicklook(const QuickLookRecord& record);
@@ -179,8 +180,10 @@ class SessionReader {
   bool has_truth_set(std::uint64_t set_index) const;
   std::uint64_t truth_set_count() const;                   // sets with /truth/sets/<index>
   TruthSet truth_set(std::uint64_t set_index) const;       // bad_input if absent
-  // The quick-look numbers stored with the session, in the order they were written; empty if
-  // none (sessions recorded without a quick-look, or before tomorig stored them).
+  // The quick-look numbers stored with the session, one record per set in set order (rows of
+  // the same set, e.g. its statistics and, later, its preview volume, merged: measured figures
+  // fill unmeasured ones, flags take the worse); empty if none (sessions recorded without a
+  // quick-look, or before tomorig stored them).
   std::vector<QuickLookRecord> quicklook() const;
 
  private:
