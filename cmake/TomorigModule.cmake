@@ -18,14 +18,46 @@ endfunction()
 
 # tomorig_add_test(MODULE SOURCES... [DEPS ...]) -> one GoogleTest executable per module,
 # registered with ctest through gtest_discover_tests.
+#
+# Real-data tests (names matching TOMORIG_REAL_DATA_TESTS: they read ../shared/data) carry the
+# ctest label `real_data` (`ctest -L real_data`). Where ../shared/data exists (CI, the main
+# checkout) TOMORIG_REAL_DATA_REQUIRED is 1 and they fail, not skip, when their sample is missing
+# (tests/support/real_data.h). A suite whose sources run the tomorig binary (they include
+# cli_runner.h or child_process.h) depends on it, so it is built first.
+set(TOMORIG_REAL_DATA_TESTS "*RealData*:*Fluidimage*" CACHE STRING "gtest filter of the tests that read ../shared/data")
+if(EXISTS "${PROJECT_SOURCE_DIR}/../shared/data")
+  set(TOMORIG_REAL_DATA_DEFAULT ON)
+else()
+  set(TOMORIG_REAL_DATA_DEFAULT OFF)
+endif()
+option(TOMORIG_REQUIRE_REAL_DATA "Real-data tests fail instead of skipping when their sample is missing"
+       ${TOMORIG_REAL_DATA_DEFAULT})
+
 function(tomorig_add_test module)
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
   add_executable(test_${module} ${ARG_SOURCES})
   target_link_libraries(test_${module} PRIVATE ${ARG_DEPS} tomorig::large_pages GTest::gtest GTest::gtest_main)
+  if(TOMORIG_REQUIRE_REAL_DATA)
+    set(real_data_required 1)
+  else()
+    set(real_data_required 0)
+  endif()
   target_compile_definitions(test_${module} PRIVATE
       TOMORIG_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
       TOMORIG_SHARED_DIR="${PROJECT_SOURCE_DIR}/../shared"
-      TOMORIG_BINARY="$<TARGET_FILE:tomorig>")
+      TOMORIG_BINARY="$<TARGET_FILE:tomorig>"
+      TOMORIG_REAL_DATA_REQUIRED=${real_data_required})
+  foreach(source ${ARG_SOURCES})
+    get_filename_component(path ${source} ABSOLUTE)
+    file(STRINGS ${path} runs_binary REGEX "#include \"(cli_runner|child_process)\\.h\"")
+    if(runs_binary AND TARGET tomorig)
+      add_dependencies(test_${module} tomorig)
+      break()
+    endif()
+  endforeach()
   include(GoogleTest)
-  gtest_discover_tests(test_${module} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 300)
+  gtest_discover_tests(test_${module} DISCOVERY_TIMEOUT 60 TEST_FILTER "-${TOMORIG_REAL_DATA_TESTS}"
+                       PROPERTIES TIMEOUT 300)
+  gtest_discover_tests(test_${module} DISCOVERY_TIMEOUT 60 TEST_FILTER "${TOMORIG_REAL_DATA_TESTS}"
+                       PROPERTIES TIMEOUT 300 LABELS real_data)
 endfunction()

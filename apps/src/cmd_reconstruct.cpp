@@ -76,9 +76,10 @@ void run(const ReconstructArgs& args) {
     throw bad_input(fmt::format("--set {} is out of range: session '{}' has {} sets (0 to {})", args.set,
                                 args.session, session.set_count(),
                                 session.set_count() == 0 ? 0 : session.set_count() - 1));
-  const SessionCameras cameras = session_cameras(session, args.calib);
+  const pipeline::SessionDescription description = pipeline::describe_session(session);
+  const SessionCameras cameras = session_cameras(description, args.calib);
 
-  ReconstructionSetup setup = reconstruction_setup(session, args.session, cameras,
+  ReconstructionSetup setup = reconstruction_setup(description, cameras,
                                                    {.algorithm = args.algorithm,
                                                     .algorithm_from_rig = true,
                                                     .iterations = args.iterations,

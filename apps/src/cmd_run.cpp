@@ -1,68 +1,30 @@
-// tomorig run: the main job. Trigger device, cameras and recorder in one process:
-//
-//   trigger -> cameras -> FrameSetAssembler -> (sender thread) inproc PUSH -> PULL -> recorder
-//
-// The recorder is the same stream consumer a separate `tomorig record` would be, so the
-// in-process rig and the split rig (tomorig acquire + tomorig record) share one data path.
-// With no arguments it runs the embedded simulated 4-camera tpiv-thesis rig.
-#include <atomic>
-#include <cerrno>
-#include <chrono>
+// tomorig run: the main job. Trigger device, cameras and recorder in one process
+// (rig::RigRunner); with no arguments it runs the embedded simulated 4-camera tpiv-thesis rig.
 #include <ctime>
-#include <exception>
 #include <filesystem>
 #include <memory>
-#include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <fmt/core.h>
-#include <zmq.hpp>
 
 #include "commands.h"
-#include "tomorig/rig/record_layout.h"
-#include "tomorig/rig/rig_acquisition.h"
-#include "tomorig/rig/rig_run_options.h"
-#include "tomorig/rig/rig_status.h"
-#include "tomorig/rig/stop_signal.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
-#include "tomorig/core/version.h"
+#include "tomorig/rig/rig_run_options.h"
+#include "tomorig/rig/rig_runner.h"
+#include "tomorig/rig/stop_signal.h"
 #include "tomorig/storage/session_file.h"
-#include "tomorig/stream/frame_receiver.h"
-#include "tomorig/stream/frame_sender.h"
 
 namespace tomorig::app {
-
-using rig::LossTally;
-using rig::RigAcquisition;
-using rig::RigAcquisitionOptions;
-using rig::RigProgress;
-using rig::RigRunChoices;
-using rig::StatusFigures;
-using rig::StatusReporter;
-using rig::StopSignalGuard;
-using rig::add_rig_run_options;
-using rig::cameras_from_set;
-using rig::load_rig;
-using rig::rig_acquisition_options;
-using rig::run_length_text;
-using rig::pixel_bytes;
-
 namespace {
 
-using Clock = std::chrono::steady_clock;
-using namespace std::chrono_literals;
-
-constexpr const char* kInprocEndpoint = "inproc://tomorig-run";
-
-struct RunOptions {
-  RigRunChoices rig;
+struct RunArgs {
+  rig::RigRunChoices rig;
   std::string out;
   std::string compression = "none";
-  bool overwrite = false;
-  double disk_reserve_mb = 64.0;
+  rig::RecorderOptions recorder;  // overwrite and disk_reserve_mb bound directly
+  std::vector<std::string> stages;
 };
 
 std::filesystem::path default_output_path() {
@@ -74,218 +36,61 @@ std::filesystem::path default_output_path() {
   return std::filesystem::path("runs") / fmt::format("session-{}.h5", stamp);
 }
 
-// Moves assembled sets from the rig into the lossless stream on its own thread, so the
-// recorder (the main thread) and the acquisition loop never wait on each other directly:
-// ZeroMQ's queue between them is the back-pressure. Destruction stops and joins it.
-class StreamPump {
- public:
-  StreamPump(RigAcquisition& rig, stream::FrameSender& sender)
-      : thread_([this, &rig, &sender] { pump(rig, sender); }) {}
-  ~StreamPump() {
-    abort_ = true;
-    if (thread_.joinable()) thread_.join();
-  }
-  StreamPump(const StreamPump&) = delete;
-  StreamPump& operator=(const StreamPump&) = delete;
+void run(const RunArgs& args) {
+  const config::RigConfig rig = rig::load_rig(args.rig);
+  rig::RigRunOptions options;
+  options.recorder = args.recorder;
+  options.recorder.compression = rig::parse_compression_option(args.compression);
+  options.recorder.out = args.out.empty() ? default_output_path() : std::filesystem::path(args.out);
+  options.acquisition = rig::rig_acquisition_options(rig, args.rig);
+  options.status_endpoint = args.rig.status;
+  options.notice = [](const std::string& text) { fmt::print(stderr, "run: {}\n", text); };
+  for (const std::string& text : args.stages) options.stages.push_back(pipeline::parse_stage_spec(text));
 
-  bool done() const { return done_; }
-  void abort() { abort_ = true; }
-  // Rethrows what ended the pump early, if anything (call after done()).
-  void rethrow() const {
-    if (error_) std::rethrow_exception(error_);
-  }
-
- private:
-  void pump(RigAcquisition& rig, stream::FrameSender& sender) {
-    try {
-      while (!abort_) {
-        std::optional<FrameSet> set = rig.pop(100ms);
-        if (!set) {
-          if (rig.done()) break;
-          continue;
-        }
-        while (!sender.send(*set))  // no room within the timeout: the recorder is busy
-          if (abort_) break;
-      }
-    } catch (...) {
-      error_ = std::current_exception();
-    }
-    done_ = true;
-  }
-
-  std::atomic<bool> abort_{false};
-  std::atomic<bool> done_{false};
-  std::exception_ptr error_;
-  std::thread thread_;
-};
-
-std::string human_bytes(std::uintmax_t bytes) {
-  if (bytes >= 1024 * 1024) return fmt::format("{:.1f} MiB", static_cast<double>(bytes) / (1024.0 * 1024.0));
-  if (bytes >= 1024) return fmt::format("{:.1f} KiB", static_cast<double>(bytes) / 1024.0);
-  return fmt::format("{} B", bytes);
-}
-
-void run(const RunOptions& opt) {
-  config::RigConfig rig = load_rig(opt.rig);
-  const auto compression = storage::parse_compression(opt.compression);
-  if (!compression)
-    throw bad_input(fmt::format("--compression {} is not supported (none, bitshuffle-lz4)", opt.compression));
-  if (!(opt.disk_reserve_mb >= 0.0))
-    throw bad_input(fmt::format("--disk-reserve-mb {:g} is invalid: it must be >= 0", opt.disk_reserve_mb));
-
-  RigAcquisitionOptions acquisition = rig_acquisition_options(rig, opt.rig);
-  acquisition.keep_truth = true;
-
-  const std::filesystem::path out = opt.out.empty() ? default_output_path() : std::filesystem::path(opt.out);
-  if (out.has_parent_path()) {
-    std::error_code ec;
-    std::filesystem::create_directories(out.parent_path(), ec);
-    if (ec)
-      throw bad_input(fmt::format("cannot create the output folder {}: {}; choose another --out",
-                                  out.parent_path().string(), ec.message()));
-  }
-  if (std::filesystem::exists(out) && !opt.overwrite)
-    throw bad_input(fmt::format("{} exists; choose another --out or pass --overwrite", out.string()));
-
-  // Builds, configures and arms everything: a bad rig fails here, before a file exists.
-  RigAcquisition rig_run(rig, acquisition);
-
-  storage::SessionInfo info;
-  info.cameras = rig_run.session_cameras();
-  info.rig_config_toml = rig.source_text;
-  info.software_version = std::string(software_version());
-  storage::SessionWriterOptions writer_options;
-  writer_options.live = true;
-  writer_options.compression = *compression;
-  writer_options.overwrite = opt.overwrite;
-  writer_options.disk_reserve_bytes = static_cast<std::uint64_t>(opt.disk_reserve_mb * 1e6);
-  std::unique_ptr<storage::SessionWriter> writer;
-  auto open_writer = [&] {
-    writer = std::make_unique<storage::SessionWriter>(out, info, writer_options);
-    if (auto truth = rig_run.session_truth()) writer->write_truth(*truth);
-  };
-  bool sizes_known = true;
-  for (const auto& cam : info.cameras) sizes_known &= cam.width > 0 && cam.height > 0;
-  if (sizes_known) open_writer();  // otherwise the first set tells the image sizes
-
+  // Builds, configures and arms everything: a bad rig or output fails here, before a file exists.
+  rig::RigRunner runner(rig, options);
   fmt::print("tomorig run: rig '{}', {} cameras, {}{}\n", rig.name, rig.cameras.size(),
-             run_length_text(acquisition),
+             rig::run_length_text(options.acquisition),
              rig.simulation ? fmt::format(", case {} at {} ppp", rig.simulation->case_name, rig.simulation->ppp)
                             : std::string());
   std::fflush(stdout);
-
-  zmq::context_t context(1);
-  stream::SocketOptions pull;
-  pull.endpoint = {kInprocEndpoint, /*bind=*/true, false};
-  pull.timeout = 250ms;
-  stream::FrameReceiver receiver(context, pull);
-  stream::SocketOptions push = pull;
-  push.endpoint.bind = false;
-  stream::FrameSender sender(context, push);
-  StatusReporter status("recording", context, opt.rig.status);
-  if (!status.endpoint().empty()) fmt::print(stderr, "run: status JSON on {}\n", status.endpoint());
+  if (!runner.status_endpoint().empty()) fmt::print(stderr, "run: status JSON on {}\n", runner.status_endpoint());
 
   // Ctrl-C ends the run between sets: acquisition stops, the sets already taken are recorded,
   // and the file is closed complete and valid. A second Ctrl-C quits at once.
-  const StopSignalGuard stop;
-  const auto started = Clock::now();
-  rig_run.start();
-  StreamPump pump(rig_run, sender);
-
-  LossTally losses(rig_run.camera_ids());
-  StatusFigures figures;
-  figures.total = acquisition.sets;
-  std::string stopped_by;
-  std::string disk_full;
-  auto refresh = [&](bool final) {
-    const RigProgress progress = rig_run.progress();
-    const std::uint64_t in_stream = sender.stats().sets_sent - receiver.stats().sets_received;
-    figures.queue_depth = progress.queued_sets + in_stream;
-    figures.dropped_trigger_events = progress.dropped_trigger_events;
-    status.update(figures, losses, final);
-  };
-  for (;;) {
-    for (const auto& text : rig_run.take_notices()) {
-      status.break_line();
-      fmt::print(stderr, "run: {}\n", text);
-    }
-    if (stopped_by.empty() && stop.stop_requested()) {
-      stopped_by = stop.signal_name();
-      figures.state = "stopping";
-      rig_run.request_stop();
-    }
-    std::optional<FrameSet> set;
-    try {
-      set = receiver.receive();
-    } catch (const zmq::error_t& e) {
-      if (e.num() == EINTR) continue;  // a signal: the loop head decides
-      throw runtime_error(fmt::format("the in-process stream failed: {}", e.what()));
-    }
-    if (!set) {
-      if (pump.done() && receiver.stats().sets_received >= sender.stats().sets_sent) break;
-      refresh(false);
-      continue;
-    }
-    losses.add(*set);
-    if (!writer) {
-      std::string why;
-      auto cameras = cameras_from_set(*set, why);
-      if (!cameras) continue;  // counted in the losses; a later complete set starts the session
-      info.cameras = std::move(*cameras);
-      open_writer();
-    }
-    try {
-      writer->append(*set);
-    } catch (const storage::DiskFullError& e) {
-      disk_full = e.what();
-      break;
-    }
-    if (auto truth = rig_run.take_truth(set->trigger_index)) writer->write_truth_set(figures.sets, *truth);
-    ++figures.sets;
-    figures.bytes += pixel_bytes(*set);
-    refresh(false);
-  }
-  pump.abort();
-  rig_run.request_stop();
-  figures.state = disk_full.empty() && rig_run.failure().empty() ? "stopped" : "failed";
-  refresh(true);
-  pump.rethrow();
-
-  if (!writer)
-    throw runtime_error(fmt::format("no complete frame set arrived, so nothing was recorded{}",
-                                    rig_run.failure().empty() ? "" : ": " + rig_run.failure()));
-  writer->finish();
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(out, ec);
-  const double seconds = std::chrono::duration<double>(Clock::now() - started).count();
-  fmt::print("wrote {}: {} set{} x {} cameras, {} in {:.2f} s; {} lost frames, {} incomplete sets\n", out.string(),
-             figures.sets, figures.sets == 1 ? "" : "s", info.cameras.size(), human_bytes(ec ? 0 : size), seconds,
-             losses.frames_lost(), losses.incomplete_sets());
-  fmt::print("next: tomorig inspect {}\n", out.string());
-  if (!disk_full.empty())
-    throw runtime_error(fmt::format("recording stopped: {}; {} is complete with {} sets", disk_full, out.string(),
-                                    figures.sets));
-  if (!rig_run.failure().empty())
-    throw runtime_error(fmt::format("{}; {} is complete with {} sets", rig_run.failure(), out.string(), figures.sets));
-  if (!stopped_by.empty())
-    fmt::print(stderr, "stopped by {} after {} sets; the session is complete\n", stopped_by, figures.sets);
+  const rig::StopSignalGuard stop;
+  const rig::RigRunReport report = runner.run([&](const rig::RecorderReport&) { return stop.stop_requested(); });
+  const std::string out = report.recording.out.string();
+  fmt::print("{}\nnext: tomorig inspect {}\n", report.brief(), out);
+  for (const pipeline::StageReport& stage : report.stages) fmt::print(stderr, "run: stage {}\n", stage.brief());
+  if (!report.recording.disk_full.empty())
+    throw runtime_error(fmt::format("recording stopped: {}; {} is complete with {} sets", report.recording.disk_full,
+                                    out, report.recording.written));
+  if (!report.failure.empty())
+    throw runtime_error(fmt::format("{}; {} is complete with {} sets", report.failure, out, report.recording.written));
+  if (report.stopped)
+    fmt::print(stderr, "stopped by {} after {} sets; the session is complete\n", stop.signal_name(),
+               report.recording.written);
 }
 
 }  // namespace
 
 void add_run_command(CLI::App& root) {
-  auto opt = std::make_shared<RunOptions>();
+  auto args = std::make_shared<RunArgs>();
   CLI::App* cmd = root.add_subcommand(
       "run", "Run the rig: trigger, acquire and record a session (default: the embedded simulated "
              "4-camera tpiv-thesis rig)");
-  add_rig_run_options(*cmd, opt->rig, "Record");
-  cmd->add_option("-o,--out", opt->out, "Session file to write; default: runs/session-<UTC time>.h5");
-  cmd->add_option("--compression", opt->compression, "Frame compression: none | bitshuffle-lz4");
-  cmd->add_flag("--overwrite", opt->overwrite, "Replace an existing output file");
-  cmd->add_option("--disk-reserve-mb", opt->disk_reserve_mb,
+  rig::add_rig_run_options(*cmd, args->rig, "Record");
+  cmd->add_option("-o,--out", args->out, "Session file to write; default: runs/session-<UTC time>.h5");
+  cmd->add_option("--compression", args->compression, "Frame compression: none | bitshuffle-lz4");
+  cmd->add_flag("--overwrite", args->recorder.overwrite, "Replace an existing output file");
+  cmd->add_option("--disk-reserve-mb", args->recorder.disk_reserve_mb,
                   "Stop recording cleanly when the disk would have less than this many MB free")
       ->capture_default_str();
-  cmd->callback([opt] { run(*opt); });
+  cmd->add_option("--stage", args->stages,
+                  "Also feed every recorded set to this stage, TYPE[:key=value,...] (repeatable; tomorig stages "
+                  "lists them)");
+  cmd->callback([args] { run(*args); });
 }
 
 }  // namespace tomorig::app

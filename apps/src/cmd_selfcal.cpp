@@ -99,7 +99,7 @@ std::vector<std::uint64_t> parse_sets(const std::string& text, std::uint64_t set
   return sets;
 }
 
-calibration::VolumeBounds volume_bounds(const SelfcalArgs& args, const storage::SessionReader& session) {
+calibration::VolumeBounds volume_bounds(const SelfcalArgs& args, const pipeline::SessionDescription& session) {
   if (!args.volume.empty()) {
     const auto v = parse_numbers(args.volume, "--volume", "xmin,ymin,zmin,xmax,ymax,zmax in mm");
     if (v.size() != 6)
@@ -157,8 +157,9 @@ void run(const SelfcalArgs& args) {
   if (args.subvolumes.size() != 3)
     throw bad_input("--subvolumes takes three whole numbers nx,ny,nz, e.g. 5,5,3");
   const storage::SessionReader session(args.session);
-  const SessionCameras cameras = session_cameras(session, args.calib);
-  const calibration::VolumeBounds bounds = volume_bounds(args, session);
+  const pipeline::SessionDescription description = pipeline::describe_session(session);
+  const SessionCameras cameras = session_cameras(description, args.calib);
+  const calibration::VolumeBounds bounds = volume_bounds(args, description);
   if (const std::string problem = bounds.validate(); !problem.empty()) throw bad_input("--volume: " + problem);
   const std::vector<std::uint64_t> sets = parse_sets(args.sets, session.set_count(), args.session);
 
@@ -224,7 +225,7 @@ void run(const SelfcalArgs& args) {
 
   std::vector<std::optional<double>> truth_before(models.size()), truth_after(models.size());
   if (truth && !true_particles.empty()) {
-    const SessionCameras true_cameras = truth_cameras(session);
+    const SessionCameras true_cameras = truth_cameras(description);
     for (std::size_t c = 0; c < models.size(); ++c) {
       truth_before[c] = calibration::projection_difference(*models[c], *true_cameras.models[c], true_particles).mean_px;
       truth_after[c] = calibration::projection_difference(*r.models[c], *true_cameras.models[c], true_particles).mean_px;

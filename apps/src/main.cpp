@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   add_config_command(app);
   add_process_command(app);
   add_piv3d_command(app);
+  add_stages_command(app);
   tomorig::bench::add_bench_command(app);
   add_trigger_command(app);
 

@@ -22,22 +22,50 @@ VoxelGrid centred_grid(int nx, int ny, int nz, double voxel_mm, const Vec3d& cen
 
 }  // namespace
 
+const config::RigConfig* SessionDescription::rig_config() const {
+  if (rig_toml.empty()) return nullptr;
+  if (!rig) throw bad_input(rig_error);
+  return &*rig;
+}
+
+SessionDescription describe_recording(std::string name, std::vector<storage::SessionCamera> cameras,
+                                      std::string rig_toml, std::optional<storage::SessionTruth> truth) {
+  SessionDescription d;
+  d.name = std::move(name);
+  d.cameras = std::move(cameras);
+  d.truth = std::move(truth);
+  d.rig_toml = std::move(rig_toml);
+  if (!d.rig_toml.empty()) {
+    try {
+      d.rig = config::parse_rig_config(d.rig_toml, d.name + ":/config");
+    } catch (const Error& e) {
+      d.rig_error = e.what();
+    }
+  }
+  return d;
+}
+
+SessionDescription describe_session(const storage::SessionReader& session) {
+  return describe_recording(session.path().string(), session.info().cameras, session.info().rig_config_toml,
+                            session.has_truth() ? std::optional(session.truth()) : std::nullopt);
+}
+
 std::vector<const calibration::CameraModel*> SessionCameras::pointers() const {
   std::vector<const calibration::CameraModel*> out;
   for (const auto& m : models) out.push_back(m.get());
   return out;
 }
 
-SessionCameras truth_cameras(const storage::SessionReader& session) {
-  const std::string file = session.path().string();
-  if (!session.has_truth())
+SessionCameras truth_cameras(const SessionDescription& session) {
+  const std::string& file = session.name;
+  if (!session.truth)
     throw bad_input(fmt::format("session '{}' is not simulated, so it has no truth cameras; give a calibration "
                                 "file with --calib",
                                 file));
-  const storage::SessionTruth truth = session.truth();
+  const storage::SessionTruth& truth = *session.truth;
   SessionCameras out;
   out.source = "truth of " + file;
-  for (const storage::SessionCamera& cam : session.info().cameras) {
+  for (const storage::SessionCamera& cam : session.cameras) {
     const storage::TruthCamera* match = nullptr;
     for (const auto& t : truth.cameras)
       if (t.id == cam.id) match = &t;
@@ -62,13 +90,13 @@ SessionCameras truth_cameras(const storage::SessionReader& session) {
   return out;
 }
 
-SessionCameras calibration_cameras(const storage::SessionReader& session, const std::filesystem::path& file) {
+SessionCameras calibration_cameras(const SessionDescription& session, const std::filesystem::path& file) {
   const std::vector<calibration::CameraCalibration> cal = calibration::load_calibration(file);
-  const auto& cams = session.info().cameras;
+  const auto& cams = session.cameras;
   if (cal.size() != cams.size())
     throw bad_input(fmt::format("calibration file '{}' has {} cameras but session '{}' has {}; use the calibration "
                                 "of this rig",
-                                file.string(), cal.size(), session.path().string(), cams.size()));
+                                file.string(), cal.size(), session.name, cams.size()));
   SessionCameras out;
   out.source = file.string();
   out.models.resize(cams.size());
@@ -88,27 +116,23 @@ SessionCameras calibration_cameras(const storage::SessionReader& session, const 
   return out;
 }
 
-SessionCameras session_cameras(const storage::SessionReader& session, const std::string& calib) {
+SessionCameras session_cameras(const SessionDescription& session, const std::string& calib) {
   if (calib == "truth") return truth_cameras(session);
   if (!calib.empty()) return calibration_cameras(session, calib);
-  if (session.has_truth()) return truth_cameras(session);
-  const std::string& toml = session.info().rig_config_toml;
-  if (!toml.empty()) {
-    const config::RigConfig rig = config::parse_rig_config(toml, session.path().string() + ":/config");
-    if (rig.calibration_file) return calibration_cameras(session, *rig.calibration_file);
-  }
+  if (session.truth) return truth_cameras(session);
+  if (const config::RigConfig* rig = session.rig_config(); rig != nullptr && rig->calibration_file)
+    return calibration_cameras(session, *rig->calibration_file);
   throw bad_input(fmt::format("session '{}' has neither truth cameras nor a calibration file in its rig config; give "
                               "one with --calib",
-                              session.path().string()));
+                              session.name));
 }
 
-VoxelGrid grid_from_session(const storage::SessionReader& session) {
-  const std::string& toml = session.info().rig_config_toml;
-  if (toml.empty())
+VoxelGrid grid_from_session(const SessionDescription& session) {
+  const config::RigConfig* rig = session.rig_config();
+  if (rig == nullptr)
     throw bad_input(fmt::format("session '{}' holds no rig config, so no voxel grid; give one with --grid",
-                                session.path().string()));
-  const config::RigConfig rig = config::parse_rig_config(toml, session.path().string() + ":/config");
-  const config::GridConfig& g = rig.grid;
+                                session.name));
+  const config::GridConfig& g = rig->grid;
   return centred_grid(g.nx, g.ny, g.nz, g.voxel_size_mm, {g.origin_mm[0], g.origin_mm[1], g.origin_mm[2]});
 }
 
@@ -136,18 +160,17 @@ VoxelGrid parse_grid(const std::string& text) {
                       centre);
 }
 
-ReconstructionSetup reconstruction_setup(const storage::SessionReader& session, const std::string& session_path,
-                                         const SessionCameras& cameras, const ReconstructionChoices& choices) {
+ReconstructionSetup reconstruction_setup(const SessionDescription& session, const SessionCameras& cameras,
+                                         const ReconstructionChoices& choices) {
   ReconstructionSetup setup;
   recon::ReconstructionOptions& options = setup.options;
   options.algorithm = choices.algorithm;
   options.relaxation = choices.relaxation;
   options.mlos_threshold = choices.mlos_threshold;
   options.threads = choices.threads;
-  if (!session.info().rig_config_toml.empty()) {
-    const config::RigConfig rig = config::parse_rig_config(session.info().rig_config_toml, session_path + ":/config");
-    if (options.algorithm.empty() && choices.algorithm_from_rig) options.algorithm = rig.processing.algorithm;
-    options.max_iterations = rig.processing.iterations;
+  if (const config::RigConfig* rig = session.rig_config()) {
+    if (options.algorithm.empty() && choices.algorithm_from_rig) options.algorithm = rig->processing.algorithm;
+    options.max_iterations = rig->processing.iterations;
   }
   if (options.algorithm.empty()) options.algorithm = "fmart";
   if (choices.iterations > 0) options.max_iterations = choices.iterations;
@@ -157,7 +180,7 @@ ReconstructionSetup reconstruction_setup(const storage::SessionReader& session, 
   input.cameras = cameras.pointers();
   input.grid = choices.grid.empty() ? grid_from_session(session) : parse_grid(choices.grid);
   input.psf.assign(input.cameras.size(), recon::PsfModel::constant(choices.sigma_px));
-  for (const storage::SessionCamera& c : session.info().cameras) input.sensor_sizes.push_back({c.width, c.height});
+  for (const storage::SessionCamera& c : session.cameras) input.sensor_sizes.push_back({c.width, c.height});
   if (!input.psf.empty()) input.psf.front().validate("--sigma-px");
   return setup;
 }

@@ -14,6 +14,7 @@
 
 #include "child_process.h"
 #include "cli_runner.h"
+#include "real_data.h"
 #include "tomorig/storage/results_file.h"
 #include "tomorig/storage/session_file.h"
 
@@ -370,7 +371,7 @@ TEST_F(ProcessCli, Piv3dCorrelatesTheVolumesOfReconstruct) {
 TEST(ProcessRealData, FluidimageDoubleFrameProcessesEndToEnd) {
   if (!tomorig_built()) GTEST_SKIP() << "tomorig is not built";
   const fs::path data = fs::path(TOMORIG_SHARED_DIR) / "data" / "fluidimage-tomopiv" / "particle";
-  if (!fs::exists(data / "cam0.pre" / "im00001a.tif")) GTEST_SKIP() << "fluidimage sample not found under " << data;
+  TOMORIG_NEED_REAL_DATA(data / "cam0.pre" / "im00001a.tif");
   const fs::path calib = fs::path(TOMORIG_SOURCE_DIR) / "docs" / "data" / "fluidimage-calibration.toml";
   TempDir dir;
   const std::string session = (dir / "real.h5").string(), results = (dir / "real-r.h5").string();

@@ -2,6 +2,8 @@
 // errors for sequences that do not fit together.
 #include <gtest/gtest.h>
 
+#include "real_data.h"
+
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -72,7 +74,7 @@ ImportOptions options_for(const TempDir& dir, const std::vector<std::string>& ca
 
 TEST(ImageImport, FluidimageTomoPivSample) {
   const fs::path root = fs::path(TOMORIG_SHARED_DIR) / "data" / "fluidimage-tomopiv" / "particle";
-  if (!fs::exists(root / "cam0.pre" / "im00001a.tif")) GTEST_SKIP() << "sample not found under " << root;
+  TOMORIG_NEED_REAL_DATA(root / "cam0.pre" / "im00001a.tif");
   TempDir dir;
   ImportOptions o;
   for (int c = 0; c < 4; ++c) {

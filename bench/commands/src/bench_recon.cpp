@@ -126,10 +126,11 @@ void run_session(const BenchReconArgs& args, const recon::ReconstructionOptions&
   if (args.set >= session.set_count())
     throw bad_input(fmt::format("--set {} is out of range: session '{}' has {} sets", args.set, args.session,
                                 session.set_count()));
-  const SessionCameras cameras = session_cameras(session, args.calib);
+  const pipeline::SessionDescription description = pipeline::describe_session(session);
+  const SessionCameras cameras = session_cameras(description, args.calib);
   recon::ReconstructionInput input;
   input.cameras = cameras.pointers();
-  input.grid = args.grid.empty() ? grid_from_session(session) : parse_grid(args.grid);
+  input.grid = args.grid.empty() ? grid_from_session(description) : parse_grid(args.grid);
   for (const storage::SessionCamera& c : session.info().cameras) input.sensor_sizes.push_back({c.width, c.height});
   const FrameSet set = session.read_set(args.set);
   for (const auto& c : set.cameras) input.images.push_back(c.a.image);

@@ -5,6 +5,8 @@
 // models that fit the detected points to well under a pixel.
 #include <gtest/gtest.h>
 
+#include "real_data.h"
+
 #include <cstdlib>
 #include <filesystem>
 #include <string>
@@ -30,7 +32,7 @@ fs::path sample_dir() {
 
 TEST(DotGridFluidimage, EveryCameraAndPlaneDetectsAndFits) {
   const fs::path root = sample_dir() / "calibration";
-  if (!fs::exists(root / "cam0" / "0mm_cam0.tif")) GTEST_SKIP() << "fluidimage sample not found at " << root;
+  TOMORIG_NEED_REAL_DATA(root / "cam0" / "0mm_cam0.tif");
   tomorig::calibration::DotGridSpec spec;
   spec.spacing_mm = 3;
   // z points towards the cameras on this rig (the target's image grows with z), so a

@@ -1,11 +1,14 @@
 #pragma once
-// What a reconstruction needs from a session besides its pixels: the camera models, in the
-// session's camera order, and the voxel grid. Shared by `reconstruct`, `bench recon` and the
-// back-end pipeline.
+// What a reconstruction needs from a recording besides its pixels: the camera models, in the
+// session's camera order, and the voxel grid. Shared by `reconstruct`, `selfcal`, `bench
+// recon`, the back-end (run_backend) and the back-end stage of a live rig.
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "tomorig/config/rig_config.h"
 
 #include "tomorig/core/volume.h"
 #include "tomorig/processing/calibration/camera_model.h"
@@ -13,6 +16,27 @@
 #include "tomorig/storage/session_file.h"
 
 namespace tomorig::pipeline {
+
+// A recording as a reconstruction sees it, a session file or a live rig alike: its cameras,
+// its rig configuration (parsed once, here) and, when simulated, the truth.
+struct SessionDescription {
+  std::string name;  // the session path, or the live rig, for messages
+  std::vector<storage::SessionCamera> cameras;
+  std::optional<storage::SessionTruth> truth;
+  std::string rig_toml;                  // as stored; empty: the recording holds no rig config
+  std::optional<config::RigConfig> rig;  // parsed rig_toml; nullopt if empty or invalid
+  std::string rig_error;                 // why rig_toml did not parse (raised only when the rig is needed)
+
+  // The rig config, or nullptr if the recording holds none; throws the parse error (bad_input)
+  // if it holds an invalid one.
+  const config::RigConfig* rig_config() const;
+};
+
+// Reads `session`'s cameras, truth and rig config.
+SessionDescription describe_session(const storage::SessionReader& session);
+// A live or replayed recording: `rig_toml` is parsed here; `name` is used in messages.
+SessionDescription describe_recording(std::string name, std::vector<storage::SessionCamera> cameras,
+                                      std::string rig_toml, std::optional<storage::SessionTruth> truth);
 
 struct SessionCameras {
   std::vector<std::shared_ptr<const calibration::CameraModel>> models;  // session camera order
@@ -23,20 +47,20 @@ struct SessionCameras {
 // The simulator's exact cameras stored in the session's /truth. Throws tomorig::Error
 // (bad_input) if the session has no truth (then a calibration file is needed) or its truth
 // cameras do not match the session's cameras by id and size.
-SessionCameras truth_cameras(const storage::SessionReader& session);
+SessionCameras truth_cameras(const SessionDescription& session);
 
 // The models of a calibration file (docs/calibration.md): its camera i is the session's camera
 // i. Throws tomorig::Error (bad_input) if the file is bad, or its camera count or image sizes
 // disagree with the session's, naming the camera.
-SessionCameras calibration_cameras(const storage::SessionReader& session, const std::filesystem::path& file);
+SessionCameras calibration_cameras(const SessionDescription& session, const std::filesystem::path& file);
 
 // `calib` empty or "truth": truth_cameras (empty falls back to the rig config's calibration
 // file when the session has no truth); otherwise calibration_cameras.
-SessionCameras session_cameras(const storage::SessionReader& session, const std::string& calib);
+SessionCameras session_cameras(const SessionDescription& session, const std::string& calib);
 
 // The [grid] of the session's rig config, as a VoxelGrid (the config gives the grid centre;
 // VoxelGrid wants the centre of voxel (0, 0, 0)).
-VoxelGrid grid_from_session(const storage::SessionReader& session);
+VoxelGrid grid_from_session(const SessionDescription& session);
 
 // "nx,ny,nz,voxel_mm" or "nx,ny,nz,voxel_mm,cx,cy,cz" (cx..cz: grid centre, mm; default 0).
 // Throws tomorig::Error (bad_input) quoting `text` and the expected form.
@@ -63,7 +87,7 @@ struct ReconstructionSetup {
   recon::ReconstructionOptions options;
   recon::ReconstructionInput input;
 };
-ReconstructionSetup reconstruction_setup(const storage::SessionReader& session, const std::string& session_path,
-                                         const SessionCameras& cameras, const ReconstructionChoices& choices);
+ReconstructionSetup reconstruction_setup(const SessionDescription& session, const SessionCameras& cameras,
+                                         const ReconstructionChoices& choices);
 
 }  // namespace tomorig::pipeline

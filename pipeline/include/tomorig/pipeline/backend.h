@@ -1,0 +1,93 @@
+#pragma once
+// The back-end (thesis Ch. 3-5 as a production run): for each set of a session, preprocess the
+// frames, reconstruct both exposures, correlate them; the vector fields and their ensemble
+// statistics go into a results file (storage/results_file.h) that is complete after every set,
+// so an interrupted run resumes where it stopped. Reconstruction of one set overlaps the
+// correlation of the previous one when memory allows.
+//
+//   pipeline::BackendOptions options;  options.out = "results.h5";
+//   const pipeline::BackendReport report = pipeline::run_backend("session.h5", options);
+//   fmt::print("{}\n", report.brief());
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "tomorig/core/geometry.h"
+#include "tomorig/pipeline/correlation_args.h"
+#include "tomorig/pipeline/session_geometry.h"
+
+namespace tomorig::pipeline {
+
+struct BackendOptions {
+  std::filesystem::path out;  // the results file; an existing one of the same session is resumed
+  // Cameras: "truth" (a simulated session's exact cameras), a calibration file, or empty: the
+  // truth if present, else the rig config's calibration file.
+  std::string calib;
+  // Preprocessing chain ([[preprocess.steps]] TOML, docs/preprocessing.md); empty: none.
+  std::filesystem::path preprocess_chain;
+  // The rig config's processing.algorithm is deliberately not used: the back-end reconstructs
+  // with FMART unless `algorithm` says otherwise (issue 5).
+  ReconstructionChoices reconstruction{.algorithm_from_rig = false};
+  std::vector<double> smooth;  // Gaussian smoothing sigma x,y,z (voxel) of each volume; empty: none
+  CorrelationArgs correlation;
+  std::int64_t dt_ns = 0;      // pulse separation for sessions that did not record it; 0: the session's
+  std::uint64_t max_sets = 0;  // process only the first N sets; 0: all
+  int threads = 0;             // OpenMP threads per stage; 0: all cores
+  bool overwrite = false;      // start a new results file even if one exists
+  bool sequential = false;     // never overlap reconstruction and correlation
+  std::filesystem::path png;   // also draw the mean field's middle z-slice here; empty: no picture
+
+  // Throws tomorig::Error (bad_input) naming the option.
+  void validate() const;
+};
+
+// One set finished (for progress lines).
+struct BackendSetDone {
+  std::uint64_t index = 0;
+  std::size_t vectors = 0;
+  double valid_fraction = 0.0;
+  double seconds = 0.0;  // from reading the set to its result written
+};
+
+struct BackendHooks {
+  // Asked between sets; true stops after the set in hand, leaving a valid, resumable file.
+  std::function<bool()> should_stop;
+  // Messages for the operator: resuming, what is about to be processed.
+  std::function<void(const std::string&)> notice;
+  // The work is about to start: this many sets to do (the resumed ones left out).
+  std::function<void(std::uint64_t sets_to_do)> started;
+  std::function<void(const BackendSetDone&)> set_done;
+};
+
+struct BackendReport {
+  std::filesystem::path out, xdmf, session;
+  std::uint64_t sets_asked = 0;      // sets of the session to be in the file (max_sets applied)
+  std::uint64_t sets_in_file = 0;
+  std::uint64_t sets_processed = 0;  // by this run
+  std::uint64_t sets_resumed = 0;    // found finished in an existing file
+  bool overlapped = false;           // reconstruction and correlation ran concurrently
+  bool interrupted = false;          // should_stop ended the run early: the file is valid and resumable
+  int nodes[3] = {0, 0, 0};
+  double mean_valid_fraction = 0.0;  // over the sets processed now
+  double mean_speed_m_s = 0.0;       // of the ensemble mean field, over nodes with a valid vector
+  Vec3d mean_displacement_voxel;     // spatial mean of the ensemble mean displacement
+  Vec3d spatial_std_displacement_voxel;
+  double seconds = 0.0;
+
+  double sets_per_second() const { return sets_processed > 0 && seconds > 0 ? sets_processed / seconds : 0.0; }
+  nlohmann::json to_json() const;
+  // "wrote r.h5 and r.xdmf: 4 sets (4 processed now, 0 resumed), ... "
+  std::string brief() const;
+};
+
+// Throws tomorig::Error: bad_input for a bad option, session, calibration or a set that cannot
+// be processed (a missing frame, no pulse separation), naming what to change; runtime for a
+// failure of the results file.
+BackendReport run_backend(const std::filesystem::path& session, const BackendOptions& options,
+                          const BackendHooks& hooks = {});
+
+}  // namespace tomorig::pipeline

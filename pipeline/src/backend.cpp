@@ -1,0 +1,233 @@
+#include "tomorig/pipeline/backend.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <optional>
+#include <sstream>
+
+#include <fmt/core.h>
+
+#include "memory_policy.h"
+#include "pair_processor.h"
+#include "session_identity.h"
+#include "tomorig/core/error.h"
+#include "tomorig/pipeline/session_preprocessor.h"
+#include "tomorig/pipeline/slice_png.h"
+#include "tomorig/pipeline/two_stage_pipeline.h"
+#include "tomorig/storage/results_file.h"
+#include "tomorig/storage/session_file.h"
+
+namespace tomorig::pipeline {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+std::string file_text(const fs::path& path) {
+  if (path.empty()) return "";
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+    throw bad_input(fmt::format("--config '{}' cannot be read; give the preprocessing chain TOML", path.string()));
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// The results file must match this run: same session first (the clearer message), then the grid.
+void check_existing_results(const fs::path& out, const std::string& identity, const nlohmann::json& grid) {
+  const storage::ResultsReader existing(out);
+  if (existing.info().session_identity != identity) return;  // the writer says "another session"
+  const nlohmann::json old = nlohmann::json::parse(existing.info().parameters_json, nullptr, false);
+  if (old.is_object() && old.contains("grid") && old["grid"] != grid)
+    throw bad_input(fmt::format("results file '{}' was made on another reconstruction grid ({}) than this run's ({}); "
+                                "its sets cannot be combined: choose another --out, the same --grid, or --overwrite",
+                                out.string(), old["grid"].dump(), grid.dump()));
+}
+
+// The pulse separation of every set to process; a missing one is found before hours of work.
+std::vector<std::int64_t> pulse_separations(const storage::SessionReader& session, const fs::path& path,
+                                            const BackendOptions& options, std::uint64_t set_total) {
+  std::vector<std::int64_t> dt(set_total);
+  for (std::uint64_t s = 0; s < set_total; ++s) {
+    dt[s] = options.dt_ns > 0 ? options.dt_ns : session.set_record(s).dt_ns;
+    if (dt[s] <= 0)
+      throw bad_input(fmt::format("set {} of session '{}' has pulse separation dt = {} ns (missing), so its velocity "
+                                  "cannot be computed; give the laser pulse separation with --dt-ns",
+                                  s, path.string(), dt[s]));
+  }
+  return dt;
+}
+
+// The ensemble mean field's summary figures, over the nodes with a valid vector.
+void summarise(const storage::EnsembleStatistics& stats, BackendReport& report) {
+  double speed = 0.0;
+  std::size_t nodes = 0;
+  Vec3d sum, sum2;  // of the mean displacement over the nodes: its spatial mean and spread
+  for (std::size_t i = 0; i < stats.mean_velocity.size(); ++i)
+    if (stats.valid_count[i] > 0) {
+      const Vec3d& u = stats.mean_velocity[i];
+      speed += std::sqrt(u.x * u.x + u.y * u.y + u.z * u.z);
+      const Vec3d& d = stats.mean_displacement_voxel[i];
+      sum = sum + d;
+      sum2 = sum2 + Vec3d{d.x * d.x, d.y * d.y, d.z * d.z};
+      ++nodes;
+    }
+  const double inv = nodes > 0 ? 1.0 / nodes : 0.0;
+  const Vec3d mean_d = sum * inv;
+  report.nodes[0] = stats.nx;
+  report.nodes[1] = stats.ny;
+  report.nodes[2] = stats.nz;
+  report.mean_speed_m_s = speed * inv;
+  report.mean_displacement_voxel = mean_d;
+  report.spatial_std_displacement_voxel = {std::sqrt(std::max(0.0, sum2.x * inv - mean_d.x * mean_d.x)),
+                                           std::sqrt(std::max(0.0, sum2.y * inv - mean_d.y * mean_d.y)),
+                                           std::sqrt(std::max(0.0, sum2.z * inv - mean_d.z * mean_d.z))};
+}
+
+void draw_mean_slice(const storage::EnsembleStatistics& stats, const fs::path& png) {
+  std::vector<bool> counted(stats.valid_count.size());
+  for (std::size_t i = 0; i < counted.size(); ++i) counted[i] = stats.valid_count[i] > 0;
+  write_slice_png(png, stats.nx, stats.ny, stats.nz, stats.nz / 2, stats.mean_displacement_voxel, counted);
+}
+
+}  // namespace
+
+void BackendOptions::validate() const {
+  if (out.empty()) throw bad_input("the back-end has no results file: give one with -o/--out");
+  if (dt_ns < 0) throw bad_input(fmt::format("--dt-ns {} must be > 0", dt_ns));
+  if (!smooth.empty() && smooth.size() != 3)
+    throw bad_input(fmt::format("--smooth takes 3 sigmas x,y,z (voxel), not {}", smooth.size()));
+}
+
+nlohmann::json BackendReport::to_json() const {
+  const Vec3d& m = mean_displacement_voxel;
+  const Vec3d& s = spatial_std_displacement_voxel;
+  return {{"out", out.string()},
+          {"xdmf", xdmf.string()},
+          {"session", session.string()},
+          {"sets_in_file", sets_in_file},
+          {"sets_processed", sets_processed},
+          {"sets_resumed", sets_resumed},
+          {"nodes", {nodes[0], nodes[1], nodes[2]}},
+          {"mean_valid_fraction", mean_valid_fraction},
+          {"mean_speed_m_s", mean_speed_m_s},
+          {"mean_displacement_voxel", {m.x, m.y, m.z}},
+          {"spatial_std_displacement_voxel", {s.x, s.y, s.z}},
+          {"seconds", seconds},
+          {"sets_per_second", sets_per_second()}};
+}
+
+std::string BackendReport::brief() const {
+  return fmt::format("wrote {} and {}: {} sets ({} processed now, {} resumed), {} x {} x {} vectors, {:.1f} % valid, "
+                     "mean speed {:.4g} m/s, {:.1f} s ({:.3g} sets/s)",
+                     out.string(), xdmf.string(), sets_in_file, sets_processed, sets_resumed, nodes[0], nodes[1],
+                     nodes[2], 100.0 * mean_valid_fraction, mean_speed_m_s, seconds, sets_per_second());
+}
+
+BackendReport run_backend(const fs::path& session_path, const BackendOptions& options, const BackendHooks& hooks) {
+  const auto started = Clock::now();
+  options.validate();
+  const auto notice = [&](const std::string& text) {
+    if (hooks.notice) hooks.notice(text);
+  };
+  const auto stop_requested = [&] { return hooks.should_stop && hooks.should_stop(); };
+
+  const storage::SessionReader session(session_path);
+  if (session.set_count() == 0)
+    throw bad_input(fmt::format("session '{}' holds no set to process", session_path.string()));
+  const PairProcessor processor(describe_session(session), options);  // the rig config parsed once
+  const recon::ReconstructionInput& input = processor.input();
+
+  BackendReport report;
+  report.out = options.out;
+  report.xdmf = storage::ResultsWriter::sidecar_path(options.out);
+  report.session = session_path;
+  report.sets_asked =
+      options.max_sets > 0 ? std::min<std::uint64_t>(options.max_sets, session.set_count()) : session.set_count();
+  const std::vector<std::int64_t> dt = pulse_separations(session, session_path, options, report.sets_asked);
+
+  const std::string identity = session_identity(session);
+  nlohmann::json parameters = processor.parameters();
+  parameters["preprocess"] = {{"chain_file", options.preprocess_chain.string()},
+                              {"chain_toml", file_text(options.preprocess_chain)}};
+  parameters["dt_override_ns"] = options.dt_ns;
+  std::error_code ec;
+  if (!options.overwrite && fs::exists(options.out, ec)) check_existing_results(options.out, identity, parameters["grid"]);
+  storage::ResultsWriter writer(options.out,
+                                {.session_path = session_path.string(),
+                                 .session_identity = identity,
+                                 .parameters_json = parameters.dump(),
+                                 .voxel_size_mm = input.grid.voxel_size},
+                                {.overwrite = options.overwrite});
+  if (writer.resumed_sets() == 0) writer.write();  // an empty, valid file from the start: the path works
+  report.sets_resumed = writer.resumed_sets();
+
+  std::vector<std::uint64_t> todo;
+  for (std::uint64_t s = 0; s < report.sets_asked; ++s)
+    if (!writer.has_set(s)) todo.push_back(s);
+  if (writer.resumed_sets() > 0)
+    notice(fmt::format("resuming {}: {} sets already finished, {} to do", options.out.string(), writer.resumed_sets(),
+                       todo.size()));
+
+  SessionPreprocessor preprocessor(session, options.preprocess_chain);
+  report.overlapped = !options.sequential && overlap_fits(input.grid, available_memory_bytes());
+  notice(fmt::format("processing {} sets of {} with {} on a {} x {} x {} grid ({}), {} cameras, {}", todo.size(),
+                     session_path.string(), processor.reconstruction().algorithm, input.grid.nx, input.grid.ny,
+                     input.grid.nz, processor.cameras().source, input.cameras.size(),
+                     report.overlapped ? "reconstruction and correlation overlapped" : "one set at a time"));
+  if (hooks.started) hooks.started(todo.size());
+
+  std::size_t next = 0;
+  const auto produce = [&](const std::function<bool()>& stop) -> std::optional<ReconstructedSet> {
+    if (next >= todo.size() || stop() || stop_requested()) return std::nullopt;
+    const auto set_started = Clock::now();
+    const std::uint64_t index = todo[next++];
+    FrameSet set = session.read_set(index);
+    preprocessor.apply(set);
+    ReconstructedSet pair = processor.reconstruct(set, index, dt[index]);
+    pair.started = set_started;  // a set's time includes reading and preprocessing it
+    return pair;
+  };
+
+  double valid_sum = 0.0;
+  const auto consume = [&](ReconstructedSet& r) -> bool {
+    if (stop_requested()) return false;
+    piv::CorrelationReport corr_report;
+    const storage::SetResult result = processor.correlate(r, corr_report);
+    writer.add(result);
+    valid_sum += corr_report.valid_fraction();
+    ++report.sets_processed;
+    if (hooks.set_done)
+      hooks.set_done({.index = r.index,
+                      .vectors = corr_report.valid + corr_report.replaced + corr_report.invalid,
+                      .valid_fraction = corr_report.valid_fraction(),
+                      .seconds = result.seconds});
+    return !stop_requested();
+  };
+
+  if (report.overlapped) {
+    TwoStagePipeline<ReconstructedSet> stages(1);
+    stages.run(produce, consume);
+  } else {
+    const std::function<bool()> never = [] { return false; };
+    while (auto r = produce(never))
+      if (!consume(*r)) break;
+  }
+
+  report.sets_in_file = writer.set_count();
+  report.mean_valid_fraction = report.sets_processed > 0 ? valid_sum / report.sets_processed : 0.0;
+  report.seconds = std::chrono::duration<double>(Clock::now() - started).count();
+  if (stop_requested()) {
+    report.interrupted = true;  // the file is valid: every finished set is in it
+    return report;
+  }
+  writer.close();  // errors surface here rather than in the destructor
+  const storage::EnsembleStatistics stats = writer.statistics();
+  summarise(stats, report);
+  if (!options.png.empty()) draw_mean_slice(stats, options.png);
+  return report;
+}
+
+}  // namespace tomorig::pipeline

@@ -1,0 +1,88 @@
+#include "pair_processor.h"
+
+#include <fmt/core.h>
+
+#include "tomorig/core/error.h"
+#include "tomorig/pipeline/report_json.h"
+#include "tomorig/processing/reconstruction/smoothing.h"
+
+namespace tomorig::pipeline {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+nlohmann::json grid_json(const VoxelGrid& g) {
+  return {{"nx", g.nx}, {"ny", g.ny}, {"nz", g.nz}, {"voxel_mm", g.voxel_size}, {"origin_mm", {g.origin.x, g.origin.y, g.origin.z}}};
+}
+
+ReconstructionSetup setup_for(const SessionDescription& recording, const SessionCameras& cameras,
+                              const BackendOptions& options) {
+  ReconstructionChoices choices = options.reconstruction;
+  choices.threads = options.threads;
+  return reconstruction_setup(recording, cameras, choices);
+}
+
+piv::CorrelationOptions correlation_for(const BackendOptions& options, const VoxelGrid& grid) {
+  CorrelationArgs args = options.correlation;
+  args.threads = options.threads;
+  const piv::CorrelationOptions corr = correlation_options(args);
+  corr.validate(grid);  // an interrogation volume larger than the grid fails here, before any work
+  return corr;
+}
+
+}  // namespace
+
+PairProcessor::PairProcessor(const SessionDescription& recording, const BackendOptions& options)
+    : name_(recording.name),
+      options_(options),
+      cameras_(session_cameras(recording, options.calib)),
+      setup_(setup_for(recording, cameras_, options)),
+      reconstructor_(recon::make_reconstructor(setup_.options)),
+      correlation_(correlation_for(options, setup_.input.grid)) {}
+
+ReconstructedSet PairProcessor::reconstruct(const FrameSet& set, std::uint64_t index, std::int64_t dt_ns) const {
+  ReconstructedSet r;
+  r.index = index;
+  r.dt_ns = dt_ns;
+  r.started = Clock::now();
+  recon::ReconstructionInput in = setup_.input;
+  for (const Exposure e : {Exposure::A, Exposure::B}) {
+    in.images.clear();
+    for (const CameraFrames& c : set.cameras) {
+      const Frame& f = c[e];
+      if (!f.present())
+        throw bad_input(fmt::format("session '{}' set {}: frame {} of camera {} is missing; process the other sets "
+                                    "with --sets or repair the recording",
+                                    name_, index, e == Exposure::A ? "A" : "B", c.camera_id));
+      in.images.push_back(f.image);
+    }
+    recon::ReconstructionReport report;
+    SparseVolume v = reconstructor_->reconstruct(in, report);
+    if (!options_.smooth.empty())
+      v = recon::gaussian_smooth(v, {options_.smooth[0], options_.smooth[1], options_.smooth[2]}, options_.threads);
+    r.reports[e == Exposure::A ? "a" : "b"] = to_json(report);
+    (e == Exposure::A ? r.a : r.b) = std::move(v);
+  }
+  return r;
+}
+
+storage::SetResult PairProcessor::correlate(const ReconstructedSet& pair, piv::CorrelationReport& report) const {
+  storage::SetResult result;
+  result.field = piv::correlate(pair.a, pair.b, correlation_, report);
+  result.set_index = pair.index;
+  result.dt_ns = pair.dt_ns;
+  result.report_json = nlohmann::json{{"reconstruction", pair.reports}, {"correlation", to_json(report)}}.dump();
+  result.seconds = std::chrono::duration<double>(Clock::now() - pair.started).count();
+  return result;
+}
+
+nlohmann::json PairProcessor::parameters() const {
+  const recon::ReconstructionOptions& r = setup_.options;
+  return {{"grid", grid_json(setup_.input.grid)},
+          {"reconstruction", {{"algorithm", r.algorithm}, {"max_iterations", r.max_iterations},
+                              {"relaxation", r.relaxation}, {"sigma_px", options_.reconstruction.sigma_px},
+                              {"smoothing_sigma_voxel", options_.smooth}, {"cameras", cameras_.source}}},
+          {"correlation", to_json(correlation_)}};
+}
+
+}  // namespace tomorig::pipeline
