@@ -191,7 +191,7 @@ std::string history_text(const QuickLookHistory& h, int rows) {
   const std::size_t shown = std::min<std::size_t>(n, static_cast<std::size_t>(std::max(rows, 0)));
   if (shown == 0) return out;
   out += fmt::format("  {:>8}  {:<5}  {:>7}  {:>6}  {:>8}  {:>9}  {:>8}  {:>6}\n", "set", "flag", "ppp", "d_tau",
-                     "dt px", "sheet mm", "thick mm", "drift");
+                     "dt px", "sheet mm", "thick mm", "alarms");
   for (std::size_t i = 0; i < shown; ++i) {
     const std::size_t k = shown == 1 ? 0 : i * (n - 1) / (shown - 1);
     const QuickLookRecord& r = h.records[k];

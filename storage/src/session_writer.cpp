@@ -472,7 +472,10 @@ void SessionWriter::append_quicklook(const QuickLookRecord& record) {
   try {
     m.write_quicklook(record);
   } catch (const h5::Failure& failure) {
-    m.fail_write(fmt::format("writing quick-look numbers of set {} to", record.set_index), failure);
+    // Only /quicklook was touched, and its reader counts whole rows: the sets stay valid, so
+    // the writer carries on (unlike a failed set).
+    throw runtime_error(fmt::format("writing quick-look numbers of set {} to session '{}' failed: {}",
+                                    record.set_index, m.partial.path().string(), failure.what()));
   }
 }
 
