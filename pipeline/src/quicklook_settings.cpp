@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "tomorig/core/error.h"
+#include "tomorig/stream/preview.h"
 
 namespace tomorig::pipeline {
 namespace {
@@ -81,6 +82,20 @@ QuickLookSettings quicklook_settings(const config::RigConfig* rig) {
   apply(q.preview.ment_iterations, p.ment_iterations);
   validate(p, "quicklook.preview");
   return s;
+}
+
+std::string preview_endpoint(const std::vector<std::string>& given) {
+  if (given.empty() || given.front().empty()) return stream::kDefaultPreviewEndpoint;
+  return given.front();
+}
+
+StageSpec quicklook_stage_spec(const std::string& endpoint, const std::vector<StageSpec>& others) {
+  for (const StageSpec& s : others)
+    if (s.type == "quicklook")
+      throw bad_input("--preview adds a quicklook stage, and --stage names one already: give either --preview or "
+                      "--stage quicklook:publish=ENDPOINT");
+  nlohmann::json table = {{"publish", endpoint}};
+  return {"quicklook", StageTable(table, "quicklook")};
 }
 
 }  // namespace tomorig::pipeline

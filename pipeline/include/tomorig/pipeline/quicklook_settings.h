@@ -4,8 +4,10 @@
 // by the rig file's [quicklook] keys (config::QuickLookConfig, docs/configuration.md), then by
 // the stage's own keys (`--stage quicklook:key=value`).
 #include <string>
+#include <vector>
 
 #include "tomorig/config/rig_config.h"
+#include "tomorig/pipeline/stage_registry.h"
 #include "tomorig/processing/quicklook/drift_monitor.h"
 #include "tomorig/processing/quicklook/dt_check.h"
 #include "tomorig/processing/quicklook/preview_volume.h"
@@ -28,5 +30,12 @@ struct QuickLookSettings {
 // defaults). Throws tomorig::Error (bad_input) naming the rig key when a value the rig file
 // could not check on its own is out of the library's range.
 QuickLookSettings quicklook_settings(const config::RigConfig* rig);
+
+// `--preview [ENDPOINT]` as given (no value or one): the endpoint to publish on, the default
+// (stream::kDefaultPreviewEndpoint) when none was given.
+std::string preview_endpoint(const std::vector<std::string>& given);
+// The quick-look stage publishing on `endpoint`. Throws bad_input if `others` already hold a
+// quicklook stage (two would publish twice).
+StageSpec quicklook_stage_spec(const std::string& endpoint, const std::vector<StageSpec>& others);
 
 }  // namespace tomorig::pipeline

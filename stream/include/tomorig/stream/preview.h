@@ -19,6 +19,10 @@ class context_t;
 
 namespace tomorig::stream {
 
+// Where `tomorig run --preview` and `tomorig replay --preview` publish quick-look results, and
+// `tomorig preview` listens, unless told otherwise.
+inline constexpr const char* kDefaultPreviewEndpoint = "tcp://127.0.0.1:5557";
+
 // Preview defaults: tiny queues so what a viewer sees is current.
 inline SocketOptions preview_socket_options(std::string address) {
   SocketOptions o;
