@@ -151,7 +151,8 @@ void replay(const ReplayOptions& opt) {
   const bool drained = seconds_since(closing) + 0.05 < opt.timeout_s;
   status.update(sent, blocked_sets, /*final=*/true);
   if (quicklook)
-    for (const pipeline::StageReport& r : quicklook->end()) fmt::print(stderr, "replay: stage {}\n", r.brief());
+    for (const pipeline::StageReport& r : quicklook->end())
+      fmt::print(stderr, "replay: stage {}\nreplay: {}\n", r.brief(), pipeline::quicklook_report_text(r));
   if (!drained)
     throw runtime_error(fmt::format("the receiver on {} stopped taking sets: sets still queued after {:g} s were "
                                     "lost ({} sets were handed to the transport)",

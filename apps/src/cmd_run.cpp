@@ -69,7 +69,10 @@ void run(const RunArgs& args) {
   const rig::RigRunReport report = runner.run([&](const rig::RecorderReport&) { return stop.stop_requested(); });
   const std::string out = report.recording.out.string();
   fmt::print("{}\nnext: tomorig inspect {}\n", report.brief(), out);
-  for (const pipeline::StageReport& stage : report.stages) fmt::print(stderr, "run: stage {}\n", stage.brief());
+  for (const pipeline::StageReport& stage : report.stages) {
+    fmt::print(stderr, "run: stage {}\n", stage.brief());
+    if (const std::string text = pipeline::quicklook_report_text(stage); !text.empty()) fmt::print(stderr, "run: {}\n", text);
+  }
   if (!report.recording.disk_full.empty())
     throw runtime_error(fmt::format("recording stopped: {}; {} is complete with {} sets", report.recording.disk_full,
                                     out, report.recording.written));

@@ -98,4 +98,23 @@ StageSpec quicklook_stage_spec(const std::string& endpoint, const std::vector<St
   return {"quicklook", StageTable(table, "quicklook")};
 }
 
+std::string quicklook_report_text(const StageReport& report) {
+  if (report.name != "quicklook" || !report.status.is_object()) return {};
+  const nlohmann::json& s = report.status;
+  auto count = [&](const char* key) { return s.value(key, std::uint64_t{0}); };
+  std::string text = fmt::format("quick-look: {} sets analysed, {} preview volumes ({} sets passed over)",
+                                 count("analysed"), count("previews"), count("previews_skipped"));
+  if (count("previews") > 0 && s.contains("preview_latency_s"))
+    text += fmt::format(", each ready within {:.2f} s of its set", s["preview_latency_s"].value("max", 0.0));
+  if (s.contains("publish") && s["publish"].is_string())
+    text += fmt::format("; {} messages published on {}, {} dropped for slow viewers", count("published"),
+                        s["publish"].get<std::string>(), count("dropped"));
+  text += fmt::format("; {} sets stored in the session", count("stored"));
+  if (count("drift_alarm_sets") > 0) text += fmt::format("; drift alarms in {} sets", count("drift_alarm_sets"));
+  if (s.contains("preview") && s["preview"].is_string() && s["preview"].get<std::string>().starts_with("off:"))
+    text += fmt::format("; preview {}", s["preview"].get<std::string>());
+  if (s.contains("preview_error")) text += fmt::format("; last preview error: {}", s["preview_error"].get<std::string>());
+  return text;
+}
+
 }  // namespace tomorig::pipeline

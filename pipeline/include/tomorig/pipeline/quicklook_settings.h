@@ -38,4 +38,9 @@ std::string preview_endpoint(const std::vector<std::string>& given);
 // quicklook stage (two would publish twice).
 StageSpec quicklook_stage_spec(const std::string& endpoint, const std::vector<StageSpec>& others);
 
+// One line on what a quicklook stage did, from its StageReport::status: messages published and
+// dropped for slow viewers, rows stored, preview volumes made and sets they passed over, alarms.
+// Empty for a report that is not a quicklook stage's.
+std::string quicklook_report_text(const StageReport& report);
+
 }  // namespace tomorig::pipeline

@@ -1,5 +1,6 @@
 #include "preview_worker.h"
 
+#include <algorithm>
 #include <exception>
 
 #include <fmt/format.h>
@@ -78,6 +79,8 @@ void PreviewWorker::run(Job& job) {
       std::lock_guard lock(mutex_);
       ++state_.previews;
       state_.preview = {true, set, result_.sheet, result_.active_voxels, result_.seconds, latency};
+      state_.latency_max_s = std::max(state_.latency_max_s, latency);
+      state_.latency_sum_s += latency;
     }
     // The drift monitor after the preview is out, so that it never delays the volume.
     if (made && outputs_.publish) {

@@ -45,6 +45,7 @@ class PreviewWorker {
     PreviewSummary preview;
     DriftSummary drift;
     std::uint64_t previews = 0, skipped = 0, failures = 0, drift_alarm_sets = 0;
+    double latency_max_s = 0, latency_sum_s = 0;  // from the stage taking a set to its preview done
     std::string last_error;  // of the last job that failed, e.g. a frame without light
   };
   State state() const;

@@ -135,6 +135,9 @@ class QuickLookStage final : public Stage {
     const PreviewWorker::State s = worker_ ? worker_->state() : final_state_;
     j["preview_failures"] = s.failures;
     if (!s.last_error.empty()) j["preview_error"] = s.last_error;
+    j["preview_latency_s"] = {{"max", s.latency_max_s},
+                              {"mean", s.previews > 0 ? nlohmann::json(s.latency_sum_s / static_cast<double>(s.previews))
+                                                      : nlohmann::json(nullptr)}};
     j["latest_preview"] = to_json(s.preview);
     j["latest_drift"] = to_json(s.drift);
     return j;
