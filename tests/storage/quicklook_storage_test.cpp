@@ -10,6 +10,7 @@
 #include <hdf5.h>
 
 #include "storage_test_support.h"
+#include "tomorig/storage/image_file.h"
 
 namespace tomorig::storage {
 namespace {
@@ -256,6 +257,24 @@ TEST(QuickLookStorage, WrongCameraCountIsRefusedAndLosesNothing) {
   writer.finish();
   EXPECT_EQ(SessionReader(path).quicklook().size(), 1u);
   EXPECT_EQ(SessionReader(path).set_count(), 1u);
+}
+
+TEST(PngInMemory, RoundTripsAndRefusesWhatIsNotAPng) {
+  for (const SampleType type : {SampleType::u8, SampleType::u16}) {
+    const Image image = testing::test_image(37, 21, type, 5);
+    const std::string bytes = encode_png(image);
+    EXPECT_EQ(bytes.substr(1, 3), "PNG");
+    EXPECT_TRUE(decode_png(bytes).same_pixels(image));
+  }
+  EXPECT_THROW(encode_png(Image::allocate(4, 4, SampleType::f32)), Error);
+  try {
+    decode_png("not a png", "thumbnail 'cam0/a'");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::bad_input);
+    EXPECT_NE(std::string(e.what()).find("thumbnail 'cam0/a'"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(decode_png(""), Error);
 }
 
 }  // namespace
