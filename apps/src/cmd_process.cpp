@@ -11,7 +11,6 @@
 #include "process_progress.h"
 #include "tomorig/core/error.h"
 #include "tomorig/pipeline/backend.h"
-#include "tomorig/processing/reconstruction/reconstructor.h"
 #include "tomorig/rig/stop_signal.h"
 
 namespace tomorig::app {
@@ -70,12 +69,7 @@ void add_process_command(CLI::App& root) {
   cmd->add_option("-o,--out", args->out, "Results file (.h5); an existing one of the same session and parameters is "
                                          "resumed")
       ->required();
-  cmd->add_option("--algorithm", r.algorithm, "Reconstruction algorithm: " + recon::algorithm_names() + " (default fmart)");
-  cmd->add_option("--iterations", r.iterations, "Reconstruction iterations (default: the rig config's)");
-  cmd->add_option("--relaxation", r.relaxation, "Relaxation mu in (0, 2]")->capture_default_str();
-  cmd->add_option("--grid", r.grid, "Voxel grid nx,ny,nz,voxel_mm[,cx,cy,cz] (default: the rig config's [grid])");
-  cmd->add_option("--sigma-px", r.sigma_px, "Gaussian sigma of the voxel-to-pixel weights, pixels")
-      ->capture_default_str();
+  pipeline::add_reconstruction_flags(*cmd, r, r.options.algorithm);
   cmd->add_option("--smooth", b.smooth, "Gaussian smoothing sigma x,y,z (voxel) of each reconstructed volume")
       ->delimiter(',')
       ->expected(3);

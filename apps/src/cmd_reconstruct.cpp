@@ -34,15 +34,10 @@ struct ReconstructArgs {
   std::string calib;
   std::uint64_t set = 0;
   std::string exposure = "both";
-  std::string algorithm;
-  int iterations = 0;
-  double relaxation = 1.0;
-  double mlos_threshold = 0.05;
-  std::string grid;
-  // Width of the voxel-to-pixel weights. Narrower than the particle images (0.75 px): wider
-  // weights blur the reconstructed blobs (Q 0.95 -> 0.87 on the reduced case, docs/reconstruction.md).
-  double sigma_px = 0.5;
-  int threads = 0;
+  // Width of the voxel-to-pixel weights (sigma_px): narrower than the particle images (0.75 px),
+  // as wider weights blur the reconstructed blobs (Q 0.95 -> 0.87 on the reduced case,
+  // docs/reconstruction.md).
+  pipeline::ReconstructionChoices recon{.algorithm_from_rig = true};
   std::string out;
   bool overwrite = false;
   bool json = false;
@@ -79,15 +74,7 @@ void run(const ReconstructArgs& args) {
   const pipeline::SessionDescription description = pipeline::describe_session(session);
   const SessionCameras cameras = session_cameras(description, args.calib);
 
-  ReconstructionSetup setup = reconstruction_setup(description, cameras,
-                                                   {.algorithm = args.algorithm,
-                                                    .algorithm_from_rig = true,
-                                                    .iterations = args.iterations,
-                                                    .relaxation = args.relaxation,
-                                                    .mlos_threshold = args.mlos_threshold,
-                                                    .threads = args.threads,
-                                                    .grid = args.grid,
-                                                    .sigma_px = args.sigma_px});
+  ReconstructionSetup setup = reconstruction_setup(description, cameras, args.recon);
   const recon::ReconstructionOptions& options = setup.options;
   const auto reconstructor = recon::make_reconstructor(options);
   recon::ReconstructionInput& input = setup.input;
@@ -96,7 +83,7 @@ void run(const ReconstructArgs& args) {
   nlohmann::json parameters = {{"algorithm", options.algorithm},
                                {"max_iterations", options.max_iterations},
                                {"relaxation", options.relaxation},
-                               {"sigma_px", args.sigma_px},
+                               {"sigma_px", args.recon.sigma_px},
                                {"smoothing_sigma_voxel", args.smooth},
                                {"cameras", cameras.source},
                                {"dt_ns", set.dt_ns}};
@@ -110,7 +97,8 @@ void run(const ReconstructArgs& args) {
                e == Exposure::A ? "A" : "B", options.algorithm, input.grid.nx, input.grid.ny, input.grid.nz);
     recon::ReconstructionReport report;
     SparseVolume volume = reconstructor->reconstruct(input, report);
-    if (!args.smooth.empty()) volume = recon::gaussian_smooth(volume, {args.smooth[0], args.smooth[1], args.smooth[2]}, args.threads);
+    if (!args.smooth.empty()) volume = recon::gaussian_smooth(volume, {args.smooth[0], args.smooth[1], args.smooth[2]},
+                                         args.recon.options.threads);
     fmt::print(stderr, "  {}\n", report.brief());
     const nlohmann::json report_json = to_json(report);
     out.add(name, volume, {options.algorithm, e == Exposure::A ? "A" : "B", report_json.dump()});
@@ -143,19 +131,8 @@ void add_reconstruct_command(CLI::App& root) {
   cmd->add_option("--exposure", args->exposure, "a, b or both")
       ->check(CLI::IsMember({"a", "b", "both", "A", "B"}))
       ->capture_default_str();
-  cmd->add_option("--algorithm", args->algorithm,
-                  "Reconstruction algorithm: " + recon::algorithm_names() + " (default: the rig config's)");
-  cmd->add_option("--iterations", args->iterations, "Iterations (default: the rig config's)");
-  cmd->add_option("--relaxation", args->relaxation, "Relaxation mu in (0, 2]")->capture_default_str();
-  cmd->add_option("--mlos-threshold", args->mlos_threshold,
-                  "Fraction of each image's maximum below which a pixel counts as empty for MLOS; higher is "
-                  "faster with fewer ghosts, lower keeps faint particles")
-      ->capture_default_str();
-  cmd->add_option("--grid", args->grid,
-                  "Voxel grid nx,ny,nz,voxel_mm[,cx,cy,cz] (default: the rig config's [grid])");
-  cmd->add_option("--sigma-px", args->sigma_px, "Gaussian sigma of the voxel-to-pixel weights (PSF), pixels, all cameras")
-      ->capture_default_str();
-  cmd->add_option("--threads", args->threads, "OpenMP threads (0: all cores)")->capture_default_str();
+  pipeline::add_reconstruction_flags(*cmd, args->recon, "the rig config's, else " + args->recon.options.algorithm);
+  cmd->add_option("--threads", args->recon.options.threads, "OpenMP threads (0: all cores)")->capture_default_str();
   cmd->add_option("-o,--out", args->out, "Volume file to write (.h5; an .xdmf sidecar is written beside it)")
       ->required();
   cmd->add_option("--smooth", args->smooth,

@@ -18,7 +18,7 @@ nlohmann::json grid_json(const VoxelGrid& g) {
 ReconstructionSetup setup_for(const SessionDescription& recording, const SessionCameras& cameras,
                               const BackendOptions& options) {
   ReconstructionChoices choices = options.reconstruction;
-  choices.threads = options.threads;
+  choices.options.threads = options.threads;
   return reconstruction_setup(recording, cameras, choices);
 }
 

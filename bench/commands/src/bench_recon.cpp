@@ -44,8 +44,8 @@ struct BenchReconArgs {
   std::vector<double> ppp;  // empty: the case's own density (default_ppp)
   std::vector<std::string> algorithms{"mlos", "fmart"};
   int iterations = 0;
-  double relaxation = 1.0;
-  double mlos_threshold = 0.05;
+  double relaxation = recon::ReconstructionOptions{}.relaxation;          // the library's default
+  double mlos_threshold = recon::ReconstructionOptions{}.mlos_threshold;  // the library's default
   BenchReconTuning tuning;        // --sigma-px, --prune
   int patch = 0;                  // patch edge p; 0: the library default (ceil(4 sigma), odd)
   int repeat = 1;                 // rounds per algorithm; rounds after the first are "warm"

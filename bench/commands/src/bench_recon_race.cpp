@@ -36,9 +36,9 @@ struct RaceArgs {
   std::vector<double> ppp{0.03, 0.05, 0.10};
   int fmart_iterations = 12;
   int smart_iterations = 20;
-  double fmart_relaxation = 1.0;
+  double fmart_relaxation = recon::ReconstructionOptions{}.relaxation;  // the library's default
   double smart_relaxation = 1.5;
-  double mlos_threshold = 0.05;
+  double mlos_threshold = recon::ReconstructionOptions{}.mlos_threshold;  // the library's default
   BenchReconTuning tuning;       // --sigma-px, --prune
   double q_target = 0.0;         // 0: the lower of the two algorithms' best Q, per density
   std::string smoothing = "0.68,0.68,0.1";

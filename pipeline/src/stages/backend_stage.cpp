@@ -28,8 +28,9 @@ class BackendStage final : public Stage {
     ReconstructionChoices& r = o.reconstruction;
     r.algorithm = table.text("algorithm", r.algorithm);
     r.iterations = static_cast<int>(table.integer("iterations", r.iterations));
-    r.relaxation = table.number("relaxation", r.relaxation);
-    r.mlos_threshold = table.number("mlos_threshold", r.mlos_threshold);
+    r.options.relaxation = table.number("relaxation", r.options.relaxation);
+    r.options.mlos_threshold = table.number("mlos_threshold", r.options.mlos_threshold);
+    r.options.prune_fraction = table.number("prune_fraction", r.options.prune_fraction);
     r.grid = table.text("grid", r.grid);
     r.sigma_px = table.number("sigma_px", r.sigma_px);
     CorrelationArgs& c = o.correlation;

@@ -12,9 +12,7 @@
 namespace tomorig::recon::detail {
 namespace {
 
-// See reconstructor.h: the weight sigma that reproduces sigma = 0.75 px particle images from
-// blobs as wide as the thesis's truth.
-constexpr double kDefaultWeightSigma = 0.5;
+constexpr double kDefaultWeightSigma = kDefaultPsfSigmaPx;  // psf_model.h
 
 void check_grid(const VoxelGrid& g) {
   if (g.nx <= 0 || g.ny <= 0 || g.nz <= 0)

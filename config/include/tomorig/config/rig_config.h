@@ -87,8 +87,10 @@ struct GridConfig {
 };
 
 struct ProcessingConfig {
-  std::string algorithm = "fmart";  // reconstruction algorithm for the back-end
-  int iterations = 5;
+  // Absent (empty / 0): the reconstruction library's default (recon::ReconstructionOptions), so
+  // each parameter has one default, in one place.
+  std::string algorithm;  // reconstruction algorithm for `tomorig reconstruct`
+  int iterations = 0;     // iterations of MART/SMART/FMART
 };
 
 struct SimulationConfig {

@@ -20,8 +20,8 @@ struct CorrelationArgs {
   std::string weighting = "gaussian";
   double gaussian_sigma = 0.5;  // fraction of the window edge: wide, for reconstructed volumes (docs/correlation.md)
   std::string interpolation = "bspline";
-  double min_peak = 0.1;
-  double max_displacement = 0.0;
+  double min_peak = piv::CorrelationOptions{}.min_peak;                  // the library's default
+  double max_displacement = piv::CorrelationOptions{}.max_displacement;  // the library's default
   int threads = 0;
 };
 

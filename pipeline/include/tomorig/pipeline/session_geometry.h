@@ -16,6 +16,10 @@
 #include "tomorig/processing/reconstruction/reconstructor.h"
 #include "tomorig/storage/session_file.h"
 
+namespace CLI {
+class App;
+}
+
 namespace tomorig::pipeline {
 
 // A recording as a reconstruction sees it, a session file or a live rig alike: its cameras,
@@ -71,19 +75,25 @@ VoxelGrid grid_from_session(const SessionDescription& session);
 // Throws tomorig::Error (bad_input) quoting `text` and the expected form.
 VoxelGrid parse_grid(const std::string& text);
 
-// The command-line side of a reconstruction set-up (`reconstruct`, `process`).
+// The command-line side of a reconstruction set-up (`reconstruct`, `process`, the backend
+// stage). Every setting has one default, the library's: `options` starts as
+// recon::ReconstructionOptions{} and the flags bind to its fields.
 struct ReconstructionChoices {
-  std::string algorithm;  // empty: the default below
-  // true (`reconstruct`): an empty algorithm takes the rig config's processing.algorithm. false
-  // (`process`): the rig's choice is ignored and FMART is the default, as issue 5 asks.
+  recon::ReconstructionOptions options;  // relaxation, mlos_threshold, prune_fraction, threads, ...
+  // Named on the command line; empty: the recording's rig config names it if
+  // `algorithm_from_rig` (`reconstruct`), else options.algorithm (`process`: the rig's choice is
+  // ignored, as issue 5 asks).
+  std::string algorithm;
   bool algorithm_from_rig = true;
-  int iterations = 0;     // 0: the rig config's processing.iterations
-  double relaxation = 1.0;
-  double mlos_threshold = 0.05;
-  int threads = 0;
-  std::string grid;       // empty: the rig config's [grid]; else as parse_grid
-  double sigma_px = 0.5;
+  int iterations = 0;  // named on the command line; 0: the rig config's, else options.max_iterations
+  std::string grid;    // empty: the rig config's [grid]; else as parse_grid
+  double sigma_px = recon::kDefaultPsfSigmaPx;  // weight (PSF) sigma of every camera, pixels
 };
+
+// Registers --algorithm, --iterations, --relaxation, --mlos-threshold, --grid and --sigma-px,
+// bound to `choices` (defaults shown from the library's options). `algorithm_default` says in
+// the help what an absent --algorithm means.
+void add_reconstruction_flags(CLI::App& cmd, ReconstructionChoices& choices, const std::string& algorithm_default);
 
 // Validated options and an input holding the cameras, grid, PSF and sensor sizes (images left
 // to the caller), from the session's rig config and `choices`. Throws tomorig::Error (bad_input)

@@ -12,6 +12,11 @@
 
 namespace tomorig::recon {
 
+// The weight sigma every camera gets when the input names no PSF (ReconstructionInput::psf
+// empty), and the default of every --sigma-px: it reproduces sigma = 0.75 px particle images
+// from blobs as wide as the thesis's truth (reconstructor.h, docs/reconstruction.md).
+inline constexpr double kDefaultPsfSigmaPx = 0.5;
+
 struct PsfSample {
   double z_mm = 0.0;        // world z of this sample
   double sigma_u_px = 0.75;  // Gaussian sigma along the ellipse's first axis (image u when angle 0), pixels
