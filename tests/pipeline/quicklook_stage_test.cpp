@@ -145,6 +145,32 @@ binning = 4
   EXPECT_EQ(s.preview.depth_factor, quicklook::PreviewVolumeOptions{}.depth_factor);
 }
 
+TEST(QuickLookStage, FramesTooSmallForTheDtCheckStillGetTheirStatistics) {
+  // 40 x 30 frames: statistics yes, no 64 px correlation window fits.
+  std::vector<storage::SessionCamera> cameras = {{"tiny", 40, 30, PixelFormat::Mono16, 7.4}};
+  FrameSet set;
+  CameraFrames c;
+  c.camera_id = "tiny";
+  for (Frame* f : {&c.a, &c.b}) {
+    f->image = Image::allocate(40, 30, SampleType::u16);
+    for (int y = 0; y < 30; ++y)
+      for (int x = 0; x < 40; ++x) f->image.at<std::uint16_t>(x, y) = static_cast<std::uint16_t>(100 + (x * 7 + y * 3) % 11);
+  }
+  set.cameras.push_back(std::move(c));
+  Stored stored;
+  pipeline::StageChain chain = pipeline::make_chain(rig::all_stages(), {pipeline::parse_stage_spec("quicklook")});
+  pipeline::SessionDescription recording = pipeline::describe_recording("tiny rig", cameras, "", std::nullopt);
+  recording.store_quicklook = [&stored](const storage::QuickLookRecord& r) { stored.records.push_back(r); };
+  chain.begin(recording);
+  chain.push(set);
+  const pipeline::StageReport r = chain.end().at(0);
+  EXPECT_TRUE(r.error.empty()) << r.error;
+  EXPECT_EQ(r.status.at("analysed"), 1);
+  ASSERT_EQ(stored.records.size(), 1u);
+  EXPECT_TRUE(std::isfinite(stored.records[0].cameras[0].background[0])) << "the statistics were measured";
+  EXPECT_TRUE(std::isnan(stored.records[0].cameras[0].dt_displacement_px)) << "the Δt check was not";
+}
+
 TEST(QuickLookStage, BadSettingsAreNamedBeforeAnySet) {
   auto message = [](const std::string& spec) {
     try {

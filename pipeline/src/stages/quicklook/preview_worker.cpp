@@ -9,9 +9,8 @@
 
 namespace tomorig::pipeline::quicklook_stage {
 
-PreviewWorker::PreviewWorker(std::unique_ptr<quicklook::PreviewVolume> preview,
-                             std::unique_ptr<quicklook::DriftMonitor> drift, std::size_t cameras, Outputs outputs)
-    : preview_(std::move(preview)), drift_(std::move(drift)), cameras_(cameras), outputs_(std::move(outputs)) {
+PreviewWorker::PreviewWorker(std::function<Parts()> build, std::size_t cameras, Outputs outputs)
+    : build_(std::move(build)), cameras_(cameras), outputs_(std::move(outputs)) {
   thread_ = std::thread([this] { work(); });
 }
 
@@ -50,6 +49,17 @@ PreviewWorker::State PreviewWorker::state() const {
 }
 
 void PreviewWorker::work() {
+  try {
+    Parts parts = build_();
+    preview_ = std::move(parts.preview);
+    drift_ = std::move(parts.drift);
+  } catch (const std::exception& e) {
+    std::lock_guard lock(mutex_);
+    state_.disabled = e.what();
+    closing_ = true;  // offers are ignored from here on
+    mailbox_.reset();
+    return;
+  }
   std::unique_lock lock(mutex_);
   for (;;) {
     changed_.wait(lock, [&] { return mailbox_.has_value() || closing_; });

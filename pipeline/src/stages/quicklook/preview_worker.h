@@ -30,9 +30,15 @@ class PreviewWorker {
     std::function<void(const storage::QuickLookRecord&)> store;  // may be empty
   };
 
-  // Either of `preview` and `drift` may be null (then that part is not run).
-  PreviewWorker(std::unique_ptr<quicklook::PreviewVolume> preview, std::unique_ptr<quicklook::DriftMonitor> drift,
-                std::size_t cameras, Outputs outputs);
+  // The preview volume and the drift monitor, either may be null (then that part is not run).
+  struct Parts {
+    std::unique_ptr<quicklook::PreviewVolume> preview;
+    std::unique_ptr<quicklook::DriftMonitor> drift;
+  };
+  // `build` makes the parts on the worker's own thread (working out the grid a camera sees
+  // takes a moment the recorder must not wait for); if it throws, the worker stops, offers are
+  // ignored and state().disabled says why.
+  PreviewWorker(std::function<Parts()> build, std::size_t cameras, Outputs outputs);
   ~PreviewWorker();  // stops without processing the waiting job
   PreviewWorker(const PreviewWorker&) = delete;
   PreviewWorker& operator=(const PreviewWorker&) = delete;
@@ -47,6 +53,7 @@ class PreviewWorker {
     std::uint64_t previews = 0, skipped = 0, failures = 0, drift_alarm_sets = 0;
     double latency_max_s = 0, latency_sum_s = 0;  // from the stage taking a set to its preview done
     std::string last_error;  // of the last job that failed, e.g. a frame without light
+    std::string disabled;    // why there is no preview (no camera models, ...); empty: running
   };
   State state() const;
 
@@ -54,6 +61,7 @@ class PreviewWorker {
   void work();
   void run(Job& job);
 
+  std::function<Parts()> build_;
   std::unique_ptr<quicklook::PreviewVolume> preview_;
   std::unique_ptr<quicklook::DriftMonitor> drift_;
   std::size_t cameras_;

@@ -12,6 +12,7 @@
 #include <chrono>
 #include <memory>
 #include <mutex>
+#include <optional>
 
 #include <fmt/format.h>
 #include <zmq.hpp>
@@ -87,9 +88,21 @@ class QuickLookStage final : public Stage {
       r.measured = frames.a.present() && frames.b.present();
       r.missing = r.measured ? "" : frames.a.present() ? "frame B missing" : "frame A missing";
       if (!r.measured) continue;
-      statistics_[c].analyse(frames.a.image, frames.b.image, r.statistics);
-      dt_checks_[c].check(frames.a.image, frames.b.image, r.dt_check);
-      backgrounds[c] = r.statistics.a.background;
+      // A frame these kernels cannot take (too small, float) is reported for its camera; it
+      // does not stop the quick-look of the others.
+      try {
+        statistics_[c].analyse(frames.a.image, frames.b.image, r.statistics);
+        backgrounds[c] = r.statistics.a.background;
+      } catch (const Error& e) {
+        r.measured = false;
+        r.missing = e.what();
+        continue;
+      }
+      try {
+        dt_checks_[c].check(frames.a.image, frames.b.image, r.dt_check);
+      } catch (const Error&) {
+        r.dt_check = {};  // not measured: null figures, red
+      }
     }
     ++counts_.analysed;
 
@@ -130,9 +143,10 @@ class QuickLookStage final : public Stage {
       j["dropped"] = dropped_;
     }
     j["publish"] = publisher_ ? nlohmann::json(publisher_->endpoint()) : nlohmann::json(nullptr);
-    j["preview"] = preview_note_.empty() ? nlohmann::json(preview_ == "off" ? "off" : settings_.preview.algorithm)
-                                         : nlohmann::json(preview_note_);
     const PreviewWorker::State s = worker_ ? worker_->state() : final_state_;
+    j["preview"] = preview_ == "off"        ? nlohmann::json("off")
+                   : !s.disabled.empty() ? nlohmann::json(fmt::format("off: {}", s.disabled))
+                                         : nlohmann::json(settings_.preview.algorithm);
     j["preview_failures"] = s.failures;
     if (!s.last_error.empty()) j["preview_error"] = s.last_error;
     j["preview_latency_s"] = {{"max", s.latency_max_s},
@@ -146,34 +160,31 @@ class QuickLookStage final : public Stage {
   bool may_skip() const override { return true; }
 
  private:
-  // The preview volume and drift monitor need the cameras' models and the grid: the truth of a
-  // simulated recording, or the rig's calibration. Without them the statistics still run.
+  // The preview volume and drift monitor need the cameras' models: the truth of a simulated
+  // recording, or the rig's calibration. Without them the statistics still run. They are built
+  // on the preview thread, so that begin() (on the recorder's thread) returns at once.
   void start_preview(const SessionDescription& recording, const QuickLookSettings& settings) {
-    std::unique_ptr<quicklook::PreviewVolume> volume;
-    std::unique_ptr<quicklook::DriftMonitor> drift;
-    try {
-      const SessionCameras cameras = session_cameras(recording, calib_);
+    auto build = [recording, settings, calib = calib_]() {
+      PreviewWorker::Parts parts;
+      const SessionCameras cameras = session_cameras(recording, calib);
       const VoxelGrid grid = grid_from_session(recording);
       std::vector<calibration::ImageSize> sizes;
       for (const storage::SessionCamera& c : recording.cameras) sizes.push_back({c.width, c.height});
-      volume = std::make_unique<quicklook::PreviewVolume>(cameras.models, sizes, grid, settings.preview);
+      parts.preview = std::make_unique<quicklook::PreviewVolume>(cameras.models, sizes, grid, settings.preview);
       if (cameras.models.size() >= 3) {
         quicklook::DriftOptions options = settings.drift;
         for (const storage::SessionCamera& c : recording.cameras) options.camera_names.push_back(c.id);
         const Vec3d low = grid.centre_of(-0.5, -0.5, -0.5);
         const Vec3d high = grid.centre_of(grid.nx - 0.5, grid.ny - 0.5, grid.nz - 0.5);
-        drift = std::make_unique<quicklook::DriftMonitor>(cameras.models, sizes,
-                                                          calibration::VolumeBounds{low, high}, options);
+        parts.drift = std::make_unique<quicklook::DriftMonitor>(cameras.models, sizes,
+                                                                calibration::VolumeBounds{low, high}, options);
       }
-    } catch (const Error& e) {
-      preview_note_ = fmt::format("off: {}", e.what());
-      return;
-    }
+      return parts;
+    };
     PreviewWorker::Outputs outputs;
     if (publisher_) outputs.publish = [this](stream::PreviewMessage m) { publish(m); };
     if (store_quicklook_) outputs.store = store_quicklook_;
-    worker_ = std::make_unique<PreviewWorker>(std::move(volume), std::move(drift), recording.cameras.size(),
-                                              std::move(outputs));
+    worker_ = std::make_unique<PreviewWorker>(std::move(build), recording.cameras.size(), std::move(outputs));
   }
 
   // Both threads publish: one socket, used by one at a time.
@@ -199,7 +210,6 @@ class QuickLookStage final : public Stage {
   Counts counts_;
   bool seen_any_ = false;
   std::uint64_t last_set_ = 0;
-  std::string preview_note_;
   std::unique_ptr<PreviewWorker> worker_;
   PreviewWorker::State final_state_;
 
