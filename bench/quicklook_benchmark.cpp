@@ -2,16 +2,21 @@
 // 0.05 ppp, d_tau 3 px, shot + read noise, 100 counts black level (rendered once by the
 // simulator). QuickLookFrame: the statistics of one exposure (both passes). QuickLookCamera:
 // a double frame with the energy balance. DtCheck: the 4 x 4 windows of 64 px of one camera.
+// PreviewVolume: the MLOS preview of one exposure of the tpiv-thesis rig (4 x 512^2, 0.05 ppp:
+// binning, reconstruction on one thread, projections, depth profile), issue 16 item 3.
 // Run on a quiet machine:  build/bench/quicklook_benchmark --benchmark_counters_tabular=true
 // The Time column is ms per frame, double frame or camera.
 #include <random>
 
 #include <benchmark/benchmark.h>
 
+#include "tomorig/processing/calibration/pinhole_camera.h"
 #include "tomorig/processing/quicklook/dt_check.h"
+#include "tomorig/processing/quicklook/preview_volume.h"
 #include "tomorig/processing/quicklook/statistics.h"
 #include "tomorig/simulators/particle_renderer.h"
 #include "tomorig/simulators/sensor.h"
+#include "tomorig/simulators/simulated_rig.h"
 
 namespace {
 
@@ -84,6 +89,25 @@ void BM_DtCheck(benchmark::State& state) {
 
 }  // namespace
 
+void BM_PreviewVolume(benchmark::State& state) {
+  const tomorig::sim::SimulatedRig rig(tomorig::sim::SimulationOptions{});
+  std::vector<std::shared_ptr<const tomorig::calibration::CameraModel>> models;
+  std::vector<tomorig::calibration::ImageSize> sizes;
+  std::vector<tomorig::Image> images;
+  const tomorig::sim::SimulatedSet set = rig.render_set(0);
+  for (std::size_t c = 0; c < rig.cameras().size(); ++c) {
+    models.push_back(std::make_shared<tomorig::calibration::PinholeCamera>(rig.cameras()[c].model));
+    sizes.push_back({rig.cameras()[c].spec.width, rig.cameras()[c].spec.height});
+    images.push_back(set.frames.cameras[c].a.image);
+  }
+  tomorig::quicklook::PreviewVolume preview(models, sizes, rig.case_definition().grid);
+  tomorig::quicklook::PreviewResult result;
+  for (auto _ : state) preview.reconstruct(images, result);
+  state.counters["active_voxels"] = static_cast<double>(result.active_voxels);
+  state.counters["thickness_mm"] = result.sheet.thickness_mm;
+}
+
 BENCHMARK(BM_QuickLookFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_QuickLookCamera)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_DtCheck)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_PreviewVolume)->Unit(benchmark::kMillisecond)->UseRealTime();

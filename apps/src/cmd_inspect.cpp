@@ -10,6 +10,7 @@
 
 #include "commands.h"
 #include "tomorig/core/error.h"
+#include "tomorig/pipeline/quicklook_history.h"
 #include "tomorig/processing/quicklook/display.h"
 #include "tomorig/storage/image_file.h"
 #include "tomorig/storage/session_file.h"
@@ -131,7 +132,7 @@ void print_text(const storage::SessionSummary& s) {
 
 void add_inspect_command(CLI::App& root) {
   auto args = std::make_shared<InspectArgs>();
-  CLI::App* cmd = root.add_subcommand("inspect", "Summarise a session file: cameras, sets, timing, missing frames");
+  CLI::App* cmd = root.add_subcommand("inspect", "Summarise a session file: cameras, sets, timing, missing frames, quick-look history");
   cmd->add_option("file", args->file, "Session file (.h5)")->required();
   cmd->add_flag("--json", args->json, "Print one JSON object instead of text");
   cmd->add_option("--png", args->png_folder,
@@ -140,10 +141,12 @@ void add_inspect_command(CLI::App& root) {
   cmd->callback([args] {
     const storage::SessionReader reader(args->file);  // throws bad_input for bad files
     const storage::SessionSummary summary = storage::summarize(reader);
+    const pipeline::QuickLookHistory history = pipeline::quicklook_history(reader);
     std::vector<std::filesystem::path> pngs;
     if (!args->png_folder.empty()) pngs = write_quicklooks(reader, args->set, args->png_folder);
     if (args->json) {
       nlohmann::json j = to_json(summary);
+      j["quicklook"] = pipeline::to_json(history);
       if (!args->png_folder.empty()) {
         j["quicklooks"] = nlohmann::json::array();
         for (const auto& p : pngs) j["quicklooks"].push_back(p.string());
@@ -151,6 +154,8 @@ void add_inspect_command(CLI::App& root) {
       fmt::print("{}\n", j.dump(2));
     } else {
       print_text(summary);
+      fmt::print("{}", history.sets > 0 ? pipeline::history_text(history)
+                                        : std::string("quick-look   none stored (recorded without a quick-look stage)\n"));
       for (const auto& p : pngs) fmt::print("quick-look   {}\n", p.string());
     }
   });

@@ -21,7 +21,11 @@
 #include "tomorig/rig/send_with_retry.h"
 #include "tomorig/rig/stop_signal.h"
 #include "tomorig/core/error.h"
+#include "tomorig/pipeline/quicklook_settings.h"
+#include "tomorig/pipeline/stage_chain.h"
+#include "tomorig/rig/rig_stages.h"
 #include "tomorig/storage/session_file.h"
+#include "tomorig/stream/preview.h"
 #include "tomorig/stream/frame_sender.h"
 
 namespace tomorig::app {
@@ -52,6 +56,8 @@ struct ReplayOptions {
   std::string sets;
   double timeout_s = 10.0;
   double wait_s = 60.0;
+  std::vector<std::string> preview;  // --preview [ENDPOINT]
+  bool preview_given = false;
 };
 
 double seconds_since(Clock::time_point t) { return duration<double>(Clock::now() - t).count(); }
@@ -95,6 +101,16 @@ void replay(const ReplayOptions& opt) {
     trigger_ns.push_back(session.set_record(i).trigger_timestamp_ns);
   const ReplaySchedule schedule = make_replay_schedule(rate, trigger_ns);
 
+  // --preview: the quick-look stage on every set sent, publishing for `tomorig preview`. It
+  // skips sets to stay current, so it never holds the replay back.
+  std::optional<pipeline::StageChain> quicklook;
+  if (opt.preview_given) {
+    const std::string endpoint = pipeline::preview_endpoint(opt.preview);
+    quicklook = pipeline::make_chain(rig::all_stages(), {pipeline::quicklook_stage_spec(endpoint, {})});
+    quicklook->begin(pipeline::describe_session(session));
+    fmt::print(stderr, "replay: quick-look results on {} (watch: tomorig preview --from {})\n", endpoint, endpoint);
+  }
+
   StopSignalGuard stop;
   zmq::context_t context(1);
   stream::SocketOptions socket;
@@ -129,6 +145,7 @@ void replay(const ReplayOptions& opt) {
                         opt.timeout_s, nullptr);
       stopped = send_with_retry(*sender, set, opt.timeout_s, &stop) == SendOutcome::stopped;
       if (sender->stats().blocked_sends != blocked_before) ++blocked_sets;
+      if (quicklook && !stopped) quicklook->push(set);
       status.update(sender->stats(), blocked_sets);
     }
     pass_start = rate.mode == ReplayRate::Mode::max ? Clock::now() : pass_start + schedule.pass_length;
@@ -162,6 +179,9 @@ void replay(const ReplayOptions& opt) {
   context.close();
   const bool drained = seconds_since(closing) + 0.05 < opt.timeout_s;
   status.update(sent, blocked_sets, /*final=*/true);
+  if (quicklook)
+    for (const pipeline::StageReport& r : quicklook->end())
+      fmt::print(stderr, "replay: stage {}\nreplay: {}\n", r.brief(), pipeline::quicklook_report_text(r));
   if (!drained)
     throw runtime_error(fmt::format("the receiver on {} stopped taking sets: sets still queued after {:g} s were "
                                     "lost ({} sets were handed to the transport)",
@@ -190,7 +210,15 @@ void add_replay_command(CLI::App& root) {
       ->capture_default_str();
   cmd->add_option("--wait", opt->wait_s,
                   "Seconds to wait for a receiver to take the session start, the first message")->capture_default_str();
-  cmd->callback([opt] { replay(*opt); });
+  cmd->add_option("--preview", opt->preview,
+                  fmt::format("Also run the quick-look on the sets sent and publish it here for 'tomorig preview'; "
+                              "without a value {}",
+                              stream::kDefaultPreviewEndpoint))
+      ->expected(0, 1);
+  cmd->callback([opt, cmd] {
+    opt->preview_given = cmd->count("--preview") > 0;
+    replay(*opt);
+  });
 }
 
 }  // namespace tomorig::app

@@ -11,6 +11,8 @@
 #include "commands.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
+#include "tomorig/pipeline/quicklook_settings.h"
+#include "tomorig/stream/preview.h"
 #include "tomorig/rig/rig_run_options.h"
 #include "tomorig/rig/rig_runner.h"
 #include "tomorig/rig/stop_signal.h"
@@ -25,6 +27,8 @@ struct RunArgs {
   std::string compression = "none";
   rig::RecorderOptions recorder;  // overwrite and disk_reserve_mb bound directly
   std::vector<std::string> stages;
+  std::vector<std::string> preview;  // --preview [ENDPOINT]: given with or without a value
+  bool preview_given = false;
 };
 
 std::filesystem::path default_output_path() {
@@ -46,6 +50,8 @@ void run(const RunArgs& args) {
   options.status_endpoint = args.rig.status;
   options.notice = [](const std::string& text) { fmt::print(stderr, "run: {}\n", text); };
   for (const std::string& text : args.stages) options.stages.push_back(pipeline::parse_stage_spec(text));
+  const std::string preview = args.preview_given ? pipeline::preview_endpoint(args.preview) : std::string();
+  if (!preview.empty()) options.stages.push_back(pipeline::quicklook_stage_spec(preview, options.stages));
 
   // Builds, configures and arms everything: a bad rig or output fails here, before a file exists.
   rig::RigRunner runner(rig, options);
@@ -55,6 +61,7 @@ void run(const RunArgs& args) {
                             : std::string());
   std::fflush(stdout);
   if (!runner.status_endpoint().empty()) fmt::print(stderr, "run: status JSON on {}\n", runner.status_endpoint());
+  if (!preview.empty()) fmt::print(stderr, "run: quick-look results on {} (watch: tomorig preview --from {})\n", preview, preview);
 
   // Ctrl-C ends the run between sets: acquisition stops, the sets already taken are recorded,
   // and the file is closed complete and valid. A second Ctrl-C quits at once.
@@ -62,7 +69,10 @@ void run(const RunArgs& args) {
   const rig::RigRunReport report = runner.run([&](const rig::RecorderReport&) { return stop.stop_requested(); });
   const std::string out = report.recording.out.string();
   fmt::print("{}\nnext: tomorig inspect {}\n", report.brief(), out);
-  for (const pipeline::StageReport& stage : report.stages) fmt::print(stderr, "run: stage {}\n", stage.brief());
+  for (const pipeline::StageReport& stage : report.stages) {
+    fmt::print(stderr, "run: stage {}\n", stage.brief());
+    if (const std::string text = pipeline::quicklook_report_text(stage); !text.empty()) fmt::print(stderr, "run: {}\n", text);
+  }
   if (!report.recording.disk_full.empty())
     throw runtime_error(fmt::format("recording stopped: {}; {} is complete with {} sets", report.recording.disk_full,
                                     out, report.recording.written));
@@ -100,7 +110,15 @@ void add_run_command(CLI::App& root) {
   cmd->add_option("--stage", args->stages,
                   "Also feed every recorded set to this stage, TYPE[:key=value,...] (repeatable; tomorig stages "
                   "lists them)");
-  cmd->callback([args] { run(*args); });
+  cmd->add_option("--preview", args->preview,
+                  fmt::format("Run the quick-look (statistics, dt check, preview volume, drift alarm) on the recorded "
+                              "sets and publish it here for 'tomorig preview'; without a value {}",
+                              stream::kDefaultPreviewEndpoint))
+      ->expected(0, 1);
+  cmd->callback([args, cmd] {
+    args->preview_given = cmd->count("--preview") > 0;
+    run(*args);
+  });
 }
 
 }  // namespace tomorig::app

@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
   add_process_command(app);
   add_piv3d_command(app);
   add_stages_command(app);
+  add_preview_command(app);
   tomorig::bench::add_bench_command(app);
   add_trigger_command(app);
 

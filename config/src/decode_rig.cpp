@@ -16,6 +16,7 @@ RigConfig decode_rig(const toml::table& root_table, std::vector<ConfigIssue>& is
   decode_grid(root, rig.grid);
   decode_processing(root, rig.processing);
   decode_simulation(root, rig.simulation);
+  decode_quicklook(root, rig.quicklook);
   root.report_unknown_keys();
   return rig;
 }

@@ -113,8 +113,20 @@ Recorder::Outcome Recorder::add(const FrameSet& set, const storage::TruthSet* tr
   return Outcome::written;
 }
 
+void Recorder::add_quicklook(const storage::QuickLookRecord& record) {
+  const std::lock_guard lock(quicklook_mutex_);
+  if (!writer_ || report_.finished) return;
+  try {
+    writer_->append_quicklook(record);
+    ++report_.quicklook_rows;
+  } catch (const Error&) {
+    ++report_.quicklook_failures;
+  }
+}
+
 const RecorderReport& Recorder::finish() {
   if (!writer_) throw runtime_error("no set could start the session, so nothing was recorded");
+  const std::lock_guard lock(quicklook_mutex_);
   if (!report_.finished) {
     writer_->finish();
     report_.finished = true;

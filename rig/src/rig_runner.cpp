@@ -194,10 +194,14 @@ RigRunReport RigRunner::Impl::run(const StopCondition& should_stop) {
     if (outcome == Recorder::Outcome::refused) continue;  // counted in the losses; a later set starts the session
     if (!stages.empty()) {
       if (!stages_begun) {  // the first set written fixed the cameras
-        stages.begin(pipeline::describe_recording(fmt::format("live rig '{}'", rig_name), recorder.cameras(),
-                                                  rig_toml, acquisition.session_truth()));
+        pipeline::SessionDescription recording = pipeline::describe_recording(
+            fmt::format("live rig '{}'", rig_name), recorder.cameras(), rig_toml, acquisition.session_truth());
+        recording.store_quicklook = [this](const storage::QuickLookRecord& r) { recorder.add_quicklook(r); };
+        stages.begin(recording);
         stages_begun = true;
       }
+      // Stages see the set under its index in the session (a refused set has none).
+      set->set_index = recorder.report().written - 1;
       stages.push(*set);
     }
     figures.sets = recorder.report().written;
@@ -214,8 +218,10 @@ RigRunReport RigRunner::Impl::run(const StopCondition& should_stop) {
   if (!recorder.started())
     throw runtime_error(fmt::format("no complete frame set arrived, so nothing was recorded{}",
                                     report.failure.empty() ? "" : ": " + report.failure));
-  report.recording = recorder.finish();
+  // Stages end first: what they still store with the session (the quick-look of the last
+  // sets) goes in before the file is closed.
   if (stages_begun) report.stages = stages.end();
+  report.recording = recorder.finish();
   report.cameras = recorder.cameras().size();
   report.frames_lost = losses.frames_lost();
   report.incomplete_sets = losses.incomplete_sets();

@@ -1,6 +1,7 @@
 #include "tomorig/storage/image_file.h"
 
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <system_error>
@@ -80,20 +81,50 @@ Image read_image(const fs::path& file, int page) {
 
 namespace tomorig::storage {
 
-void write_png(const fs::path& file, const Image& image) {
-  if (image.empty()) throw bad_input(fmt::format("cannot write '{}': the image is empty", file.string()));
+namespace {
+
+std::vector<uchar> png_bytes(const Image& image, const std::string& what) {
+  if (image.empty()) throw bad_input(fmt::format("cannot write {}: the image is empty", what));
   if (image.type() == SampleType::f32)
-    throw bad_input(fmt::format("cannot write '{}': PNG holds 8- or 16-bit samples, not float; scale the image first",
-                                file.string()));
+    throw bad_input(fmt::format("cannot write {}: PNG holds 8- or 16-bit samples, not float; scale the image first",
+                                what));
   const int cv_type = image.type() == SampleType::u8 ? CV_8UC1 : CV_16UC1;
   // A header over the pixels, no copy; imencode only reads them.
   const cv::Mat mat(image.height(), image.width(), cv_type, const_cast<std::byte*>(image.data()), image.stride_bytes());
   std::vector<uchar> encoded;
   try {
-    if (!cv::imencode(".png", mat, encoded)) throw bad_input(fmt::format("OpenCV cannot encode '{}'", file.string()));
+    if (!cv::imencode(".png", mat, encoded)) throw bad_input(fmt::format("OpenCV cannot encode {}", what));
   } catch (const cv::Exception& e) {
-    throw bad_input(fmt::format("OpenCV cannot encode '{}': {}", file.string(), e.what()));
+    throw bad_input(fmt::format("OpenCV cannot encode {}: {}", what, e.what()));
   }
+  return encoded;
+}
+
+}  // namespace
+
+std::string encode_png(const Image& image) {
+  const std::vector<uchar> bytes = png_bytes(image, "a PNG");
+  return {reinterpret_cast<const char*>(bytes.data()), bytes.size()};
+}
+
+Image decode_png(std::string_view bytes, std::string_view what) {
+  cv::Mat mat;
+  try {
+    const cv::Mat raw(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data()));
+    if (!bytes.empty()) mat = cv::imdecode(raw, cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& e) {
+    throw bad_input(fmt::format("{} is not a readable image: {}", what, e.what()));
+  }
+  if (mat.empty() || mat.channels() != 1 || (mat.depth() != CV_8U && mat.depth() != CV_16U))
+    throw bad_input(fmt::format("{} is not a single-channel 8- or 16-bit PNG", what));
+  Image out = Image::allocate(mat.cols, mat.rows, mat.depth() == CV_8U ? SampleType::u8 : SampleType::u16);
+  for (int y = 0; y < mat.rows; ++y)
+    std::memcpy(out.data() + static_cast<std::size_t>(y) * out.stride_bytes(), mat.ptr(y), out.row_bytes());
+  return out;
+}
+
+void write_png(const fs::path& file, const Image& image) {
+  const std::vector<uchar> encoded = png_bytes(image, "'" + file.string() + "'");
   const fs::path partial = fs::path(file).concat(".partial");
   {
     std::FILE* out = std::fopen(partial.c_str(), "wb");

@@ -77,6 +77,16 @@ inline constexpr const char* kAttrT = "t";
 inline constexpr const char* kParticlesA = "particles_a";
 inline constexpr const char* kParticlesB = "particles_b";
 
+// Quick-look numbers (quicklook_record.h): float tables with their column names in an
+// attribute, and the set each row is of. Live recordings create them empty with the layout
+// (SWMR cannot create objects later); other writers on first use.
+inline constexpr const char* kQuickLook = "quicklook";
+inline constexpr const char* kQuickLookSetIndex = "set_index";
+inline constexpr const char* kQuickLookSets = "sets";
+inline constexpr const char* kQuickLookCameras = "cameras";
+inline constexpr const char* kAttrColumns = "columns";
+inline std::string quicklook_path(std::string_view name) { return "/quicklook/" + std::string(name); }
+
 // Sets per chunk of the /sets datasets: small chunks would make the chunk index large for
 // long runs, and a few KiB per chunk costs nothing for short ones.
 inline constexpr hsize_t kSetsPerChunk = 512;

@@ -5,6 +5,7 @@
 #include <cctype>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <string>
 #include <unordered_set>
 #include <vector>
@@ -19,6 +20,7 @@
 #include "h5_handle.h"
 #include "h5_open.h"
 #include "isolated_probe.h"
+#include "quicklook_rows.h"
 #include "session_layout.h"
 #include "tomorig/core/camera_id.h"
 #include "tomorig/core/error.h"
@@ -124,7 +126,9 @@ struct SessionReader::Impl {
   h5::Group truth_sets_group() const;
   SessionTruth read_truth() const;
   TruthSet read_truth_set(std::uint64_t set_index, bool headers_only) const;
-  // For the isolated probe: the objects read later on demand (truth metadata, truth sets' headers).
+  std::vector<QuickLookRecord> read_quicklook() const;
+  // For the isolated probe: the objects read later on demand (truth metadata, truth sets'
+  // headers, the quick-look tables).
   void touch_lazily_read_objects() const;
 
   fs::path path;
@@ -565,6 +569,7 @@ TruthSet SessionReader::Impl::read_truth_set(std::uint64_t set_index, bool heade
 }
 
 void SessionReader::Impl::touch_lazily_read_objects() const {
+  read_quicklook();
   if (!truth) return;
   read_truth();
   h5::Group sets_group = truth_sets_group();
@@ -613,6 +618,80 @@ TruthSet SessionReader::truth_set(std::uint64_t set_index) const {
   if (!has_truth_set(set_index))
     throw bad_input(fmt::format("session '{}' holds no truth for set {}", m.path.string(), set_index));
   return m.read_truth_set(set_index, false);
+}
+
+std::vector<QuickLookRecord> SessionReader::quicklook() const {
+  h5::silence_errors();
+  return impl_->read_quicklook();
+}
+
+std::vector<QuickLookRecord> SessionReader::Impl::read_quicklook() const {
+  const Impl& m = *this;
+  std::vector<QuickLookRecord> records;
+  if (!h5::link_exists(m.file.get(), layout::kQuickLook)) return records;
+  try {
+    h5::Group group = h5::open_group(m.file.get(), layout::kQuickLook, "/quicklook");
+    struct Table {
+      h5::Dataset dataset;
+      std::vector<hsize_t> dims;
+      std::vector<std::string> columns;
+    };
+    auto open = [&](const char* name, std::size_t rank, bool with_columns) {
+      const std::string where = layout::quicklook_path(name);
+      if (!h5::link_exists(group.get(), name)) m.invalid(fmt::format("{} is missing", where));
+      Table t{h5::open_dataset(group.get(), name, where), {}, {}};
+      t.dims = h5::dims_of(t.dataset.get(), where);
+      if (t.dims.size() != rank) m.invalid(fmt::format("{} has {} dimensions, not {}", where, t.dims.size(), rank));
+      // Declared extents come from the file: bound them before anything is allocated.
+      std::optional<std::uint64_t> bytes = std::uint64_t{4};
+      for (hsize_t d : t.dims) bytes = bytes ? checked_product(*bytes, d) : std::nullopt;
+      if (bytes && rank == 1) bytes = checked_product(*bytes, 2);  // the set index is 8 bytes wide
+      m.require_memory(bytes, where);
+      m.require_stored(t.dataset.get(), bytes, where);
+      if (with_columns) {
+        t.columns = h5::read_string_list_attr(t.dataset.get(), layout::kAttrColumns, where);
+        if (t.columns.size() != t.dims.back())
+          m.invalid(fmt::format("{} has {} columns but {} column names", where, t.dims.back(), t.columns.size()));
+      }
+      return t;
+    };
+    Table index = open(layout::kQuickLookSetIndex, 1, false);
+    Table sets = open(layout::kQuickLookSets, 2, true);
+    Table cameras = open(layout::kQuickLookCameras, 3, true);
+    if (cameras.dims[1] != m.cameras.size())
+      m.invalid(fmt::format("/quicklook/cameras holds {} cameras but the session has {}", cameras.dims[1],
+                            m.cameras.size()));
+    // The set index is written last: it says how many rows are whole (a live file may hold the
+    // start of the next one in the tables).
+    const hsize_t rows = std::min({index.dims[0], sets.dims[0], cameras.dims[0]});
+    if (rows == 0) return records;
+    std::vector<std::uint64_t> set_index(index.dims[0]);
+    h5::read_all(index.dataset.get(), H5T_NATIVE_UINT64, set_index.data(), "/quicklook/set_index");
+    std::vector<float> set_values(sets.dims[0] * sets.dims[1]);
+    h5::read_all(sets.dataset.get(), H5T_NATIVE_FLOAT, set_values.data(), "/quicklook/sets");
+    std::vector<float> camera_values(cameras.dims[0] * cameras.dims[1] * cameras.dims[2]);
+    h5::read_all(cameras.dataset.get(), H5T_NATIVE_FLOAT, camera_values.data(), "/quicklook/cameras");
+
+    const std::vector<int> set_positions = detail::column_positions(quicklook_set_columns(), sets.columns);
+    const std::vector<int> camera_positions = detail::column_positions(quicklook_camera_columns(), cameras.columns);
+    const std::size_t set_width = sets.dims[1], camera_width = cameras.dims[2], n_cams = cameras.dims[1];
+    std::map<std::uint64_t, QuickLookRecord> by_set;
+    for (std::size_t r = 0; r < rows; ++r) {
+      QuickLookRecord row;
+      row.set_index = set_index[r];
+      detail::read_set_row(std::span(set_values).subspan(r * set_width, set_width), set_positions, row);
+      row.cameras.resize(n_cams);
+      for (std::size_t c = 0; c < n_cams; ++c)
+        detail::read_camera_row(std::span(camera_values).subspan((r * n_cams + c) * camera_width, camera_width),
+                                camera_positions, row.cameras[c]);
+      const auto [it, first] = by_set.try_emplace(row.set_index, row);
+      if (!first) detail::merge(it->second, row);
+    }
+    for (auto& [index, record] : by_set) records.push_back(std::move(record));
+  } catch (const h5::Failure& failure) {
+    m.corrupt(failure.what());
+  }
+  return records;
 }
 
 }  // namespace tomorig::storage

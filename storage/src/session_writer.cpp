@@ -4,6 +4,7 @@
 
 #include <array>
 #include <chrono>
+#include <mutex>
 #include <optional>
 #include <utility>
 #include <filesystem>
@@ -22,6 +23,7 @@
 #include "output_lock.h"
 #include "output_path.h"
 #include "partial_file.h"
+#include "quicklook_rows.h"
 #include "session_layout.h"
 #include "tomorig/core/camera_id.h"
 #include "tomorig/core/error.h"
@@ -95,6 +97,9 @@ struct SessionWriter::Impl {
   void create_layout(const SessionInfo& info);
   void create_camera(const SessionCamera& camera, std::size_t index, hid_t cameras_group);
   void create_set_datasets();
+  // /quicklook and its empty tables (quicklook_record.h).
+  void create_quicklook_datasets();
+  void write_quicklook(const QuickLookRecord& record);
   // Checks every frame of `set` and fills frames_/timestamps_/present_; throws bad_input
   // before anything is written.
   void collect(const FrameSet& set);
@@ -128,6 +133,13 @@ struct SessionWriter::Impl {
   std::vector<CameraStream> streams;
   std::unordered_map<std::string, std::size_t> index_of;
   h5::GrowingDataset trigger_index, trigger_timestamp, dt, frame_timestamp, frame_present;
+  h5::GrowingDataset quicklook_set_index, quicklook_sets, quicklook_cameras;
+  bool quicklook_created = false;
+  std::uint64_t quicklook_rows = 0;
+  std::vector<float> quicklook_row_;  // scratch: one set's row, then its cameras' rows
+  // append() runs on the recorder's thread, append_quicklook() on a quick-look stage's: this
+  // keeps the writer's state (counts, flush times, datasets) consistent between them.
+  std::mutex mutex;
 
   // Per-set scratch, reused so that append() does not allocate in the steady state.
   std::vector<const Frame*> frames_;        // [camera * 2 + exposure], null if missing
@@ -215,6 +227,7 @@ void SessionWriter::Impl::create_layout(const SessionInfo& info) {
   h5::write_fixed_string_list_attr(cameras.get(), layout::kAttrOrder, order, "/cameras");
   for (std::size_t i = 0; i < info.cameras.size(); ++i) create_camera(info.cameras[i], i, cameras.get());
   create_set_datasets();
+  if (options.live) create_quicklook_datasets();
 }
 
 void SessionWriter::Impl::create_camera(const SessionCamera& camera, std::size_t index, hid_t cameras_group) {
@@ -263,6 +276,55 @@ void SessionWriter::Impl::create_set_datasets() {
   dt = make(layout::kDt, H5T_STD_I64LE, {});
   frame_timestamp = make(layout::kFrameTimestamp, H5T_STD_I64LE, {n_cams, 2});
   frame_present = make(layout::kFramePresent, H5T_STD_U8LE, {n_cams, 2});
+}
+
+void SessionWriter::Impl::create_quicklook_datasets() {
+  h5::Group group = h5::create_group(file.get(), layout::kQuickLook, "/quicklook");
+  const hsize_t n_cams = streams.size();
+  auto make = [&](const char* name, hid_t type, std::vector<hsize_t> record_shape,
+                  const std::vector<std::string_view>* columns) {
+    h5::GrowingDataset::Options o;
+    o.file_type = type;
+    o.record_shape = record_shape;
+    o.chunk = {layout::kSetsPerChunk};
+    o.chunk.insert(o.chunk.end(), record_shape.begin(), record_shape.end());
+    h5::GrowingDataset d(group.get(), name, layout::quicklook_path(name), o);
+    if (columns != nullptr) {
+      h5::Dataset opened = h5::open_dataset(group.get(), name, layout::quicklook_path(name));
+      h5::write_string_list_attr(opened.get(), layout::kAttrColumns,
+                                 std::vector<std::string>(columns->begin(), columns->end()),
+                                 layout::quicklook_path(name));
+    }
+    return d;
+  };
+  const auto& set_columns = quicklook_set_columns();
+  const auto& camera_columns = quicklook_camera_columns();
+  quicklook_sets = make(layout::kQuickLookSets, H5T_IEEE_F32LE, {set_columns.size()}, &set_columns);
+  quicklook_cameras =
+      make(layout::kQuickLookCameras, H5T_IEEE_F32LE, {n_cams, camera_columns.size()}, &camera_columns);
+  quicklook_set_index = make(layout::kQuickLookSetIndex, H5T_STD_U64LE, {}, nullptr);
+  quicklook_row_.resize(std::max(set_columns.size(), camera_columns.size() * streams.size()));
+  quicklook_created = true;
+}
+
+// The tables first and the set index last, as for the sets: a reader counts a row once all of
+// it is there.
+void SessionWriter::Impl::write_quicklook(const QuickLookRecord& record) {
+  if (!quicklook_created) create_quicklook_datasets();
+  const hsize_t index = quicklook_rows;
+  const hsize_t n = index + 1;
+  const std::size_t per_camera = quicklook_camera_columns().size();
+  for (std::size_t c = 0; c < record.cameras.size(); ++c)
+    detail::camera_row(record.cameras[c], std::span(quicklook_row_).subspan(c * per_camera, per_camera));
+  quicklook_cameras.grow_to(n);
+  quicklook_cameras.write_record(index, H5T_NATIVE_FLOAT, quicklook_row_.data());
+  detail::set_row(record, quicklook_row_);
+  quicklook_sets.grow_to(n);
+  quicklook_sets.write_record(index, H5T_NATIVE_FLOAT, quicklook_row_.data());
+  quicklook_set_index.grow_to(n);
+  quicklook_set_index.write_record(index, H5T_NATIVE_UINT64, &record.set_index);
+  quicklook_rows = n;
+  if (options.live) flush_if_due();
 }
 
 std::size_t SessionWriter::Impl::camera_index(const std::string& id) const {
@@ -416,6 +478,7 @@ SessionWriter::~SessionWriter() = default;
 void SessionWriter::append(const FrameSet& set) {
   h5::silence_errors();
   Impl& m = *impl_;
+  const std::lock_guard lock(m.mutex);
   m.require_open("append a set");
   m.collect(set);
   if (m.options.disk_reserve_bytes > 0) m.require_disk_room();
@@ -428,9 +491,28 @@ void SessionWriter::append(const FrameSet& set) {
   }
 }
 
+void SessionWriter::append_quicklook(const QuickLookRecord& record) {
+  h5::silence_errors();
+  Impl& m = *impl_;
+  const std::lock_guard lock(m.mutex);
+  m.require_open("store quick-look numbers");
+  if (record.cameras.size() != m.streams.size())
+    throw bad_input(fmt::format("quick-look numbers of set {} are for {} cameras but session '{}' has {}",
+                                record.set_index, record.cameras.size(), m.final_path.string(), m.streams.size()));
+  try {
+    m.write_quicklook(record);
+  } catch (const h5::Failure& failure) {
+    // Only /quicklook was touched, and its reader counts whole rows: the sets stay valid, so
+    // the writer carries on (unlike a failed set).
+    throw runtime_error(fmt::format("writing quick-look numbers of set {} to session '{}' failed: {}",
+                                    record.set_index, m.partial.path().string(), failure.what()));
+  }
+}
+
 void SessionWriter::write_truth(const SessionTruth& truth) {
   h5::silence_errors();
   Impl& m = *impl_;
+  const std::lock_guard lock(m.mutex);
   m.require_open("write truth");
   if (m.truth_written)
     throw runtime_error(fmt::format("truth of session '{}' is already written", m.final_path.string()));
@@ -482,6 +564,7 @@ void SessionWriter::Impl::store_truth(const SessionTruth& truth) {
 void SessionWriter::write_truth_set(std::uint64_t set_index, const TruthSet& truth) {
   h5::silence_errors();
   Impl& m = *impl_;
+  const std::lock_guard lock(m.mutex);
   m.require_open("write truth");
   if (m.truth_sets.contains(set_index))
     throw runtime_error(fmt::format("truth for set {} of session '{}' is already written", set_index,
@@ -527,11 +610,13 @@ void SessionWriter::Impl::complete_live_file() {
 void SessionWriter::finish() {
   h5::silence_errors();
   Impl& m = *impl_;
+  const std::lock_guard lock(m.mutex);
   m.require_open("finish");
   const std::string partial = m.partial.path().string();
   bool closed = true;
   for (auto& s : m.streams) closed &= s.frames.close() >= 0;
-  for (auto* d : {&m.trigger_index, &m.trigger_timestamp, &m.dt, &m.frame_timestamp, &m.frame_present})
+  for (auto* d : {&m.trigger_index, &m.trigger_timestamp, &m.dt, &m.frame_timestamp, &m.frame_present,
+                  &m.quicklook_set_index, &m.quicklook_sets, &m.quicklook_cameras})
     closed &= d->close() >= 0;
   closed &= m.file.close() >= 0;  // flushes everything to disk
   if (closed && m.options.live) {
@@ -567,7 +652,10 @@ void SessionWriter::finish() {
   m.lock = OutputLock();  // the file is complete under its name: another writer may now replace it
 }
 
-std::uint64_t SessionWriter::sets_written() const { return impl_->sets; }
+std::uint64_t SessionWriter::sets_written() const {
+  const std::lock_guard lock(impl_->mutex);
+  return impl_->sets;
+}
 const fs::path& SessionWriter::path() const { return impl_->final_path; }
 const fs::path& SessionWriter::partial_path() const { return impl_->partial.path(); }
 

@@ -1,5 +1,7 @@
 #include "tomorig/stream/preview.h"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include "multipart.h"
@@ -42,6 +44,26 @@ bool PreviewPublisher::publish(const FrameSet& set) {
   return true;
 }
 
+bool PreviewPublisher::publish(const PreviewMessage& message) {
+  if (message.json.empty() || message.json.front() != '{')
+    throw bad_input("a quick-look message must start with a JSON object");
+  zmq::socket_t& socket = impl_->opened.socket;
+  const std::size_t parts = 1 + message.images.size();
+  for (std::size_t i = 0; i < parts; ++i) {
+    const std::string& bytes = i == 0 ? message.json : message.images[i - 1];
+    const auto flags = (i + 1 < parts ? zmq::send_flags::sndmore : zmq::send_flags::none) | zmq::send_flags::dontwait;
+    if (!socket.send(zmq::buffer(bytes), flags)) {
+      if (i == 0) {
+        ++impl_->stats.sets_dropped;
+        return false;
+      }
+      throw runtime_error(fmt::format("quick-look message was cut off after part {} of {}", i, parts));
+    }
+  }
+  ++impl_->stats.sets_published;
+  return true;
+}
+
 const std::string& PreviewPublisher::endpoint() const { return impl_->opened.endpoint; }
 PreviewStats PreviewPublisher::stats() const { return impl_->stats; }
 
@@ -61,6 +83,25 @@ std::optional<FrameSet> PreviewSubscriber::receive() {
   auto parts = detail::receive_multipart(impl_->opened.socket);
   if (!parts) return std::nullopt;
   return decode_frame_set(std::move(*parts));
+}
+
+std::optional<PreviewMessage> PreviewSubscriber::receive_message() {
+  auto parts = detail::receive_multipart(impl_->opened.socket);
+  if (!parts) return std::nullopt;
+  const zmq::message_t& head = (*parts)[0];
+  const auto* bytes = static_cast<const char*>(head.data());
+  if (head.size() >= 4 && std::equal(bytes, bytes + 4, reinterpret_cast<const char*>(kWireMagic)))
+    throw bad_input("a frame-set message arrived on the preview stream where quick-look results were expected; "
+                    "connect to the quick-look endpoint (tomorig run --preview), not to a frame stream");
+  if (head.size() == 0 || bytes[0] != '{')
+    throw bad_input(fmt::format("a preview message of {} parts does not start with a JSON object, so it is not a "
+                                "tomorig quick-look message",
+                                parts->size()));
+  PreviewMessage message;
+  message.json.assign(bytes, head.size());
+  for (std::size_t i = 1; i < parts->size(); ++i)
+    message.images.emplace_back(static_cast<const char*>((*parts)[i].data()), (*parts)[i].size());
+  return message;
 }
 
 }  // namespace tomorig::stream

@@ -70,6 +70,36 @@ TEST(Preview, PublisherNeverBlocksWithoutSubscribers) {
   EXPECT_EQ(publisher.stats().sets_dropped, 0u);
 }
 
+TEST(Preview, QuickLookMessagesArriveWholeAndFrameSetsAreNotTakenForThem) {
+  zmq::context_t context;
+  PreviewPublisher publisher(context, preview_socket_options("inproc://quicklook"));
+  auto sub_options = preview_socket_options("inproc://quicklook");
+  sub_options.endpoint.bind = false;
+  sub_options.timeout = 20ms;
+  PreviewSubscriber subscriber(context, sub_options);
+  // Attach: probe until a message comes through.
+  const PreviewMessage probe{R"({"type":"probe"})", {}};
+  bool attached = false;
+  for (int attempt = 0; attempt < 500 && !attached; ++attempt) {
+    publisher.publish(probe);
+    attached = subscriber.receive_message().has_value();
+  }
+  ASSERT_TRUE(attached);
+
+  PreviewMessage message{R"({"type":"tomorig.quicklook","images":[{"name":"a"},{"name":"b"}]})",
+                         {std::string("\x89PNG one", 8), std::string(5000, 'x')}};
+  ASSERT_TRUE(publisher.publish(message));
+  const auto got = subscriber.receive_message();
+  ASSERT_TRUE(got);
+  EXPECT_EQ(got->json, message.json);
+  EXPECT_EQ(got->images, message.images);
+
+  publisher.publish(pattern_set(3, 1, 4, 4, SampleType::u8));
+  expect_error([&] { subscriber.receive_message(); }, ErrorKind::bad_input, {"frame-set message"});
+  EXPECT_FALSE(subscriber.receive_message()) << "the rejected message is consumed";
+  expect_error([&] { publisher.publish(PreviewMessage{"not json", {}}); }, ErrorKind::bad_input, {"JSON object"});
+}
+
 Status sample_status() {
   Status s;
   s.time_ns = 1'700'000'000'123'456'789;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <fmt/format.h>
@@ -126,6 +127,66 @@ Image max_projection(const DenseVolume& volume, Axis axis) {
   return project(volume.grid, axis, [&](auto&& visit) {
     for (std::size_t n = 0; n < volume.values.size(); ++n) visit(n, volume.values[n]);
   });
+}
+
+}  // namespace tomorig::quicklook
+
+namespace tomorig::quicklook {
+namespace {
+
+template <typename T>
+void block_max(const Image& in, int block, Image& out) {
+  for (int y = 0; y < out.height(); ++y) {
+    float* o = out.row<float>(y);
+    std::fill(o, o + out.width(), -std::numeric_limits<float>::infinity());
+    for (int dy = 0; dy < block && y * block + dy < in.height(); ++dy) {
+      const T* r = in.row<T>(y * block + dy);
+      for (int x = 0; x < out.width(); ++x)
+        for (int dx = 0; dx < block && x * block + dx < in.width(); ++dx)
+          o[x] = std::max(o[x], static_cast<float>(r[x * block + dx]));
+    }
+  }
+}
+
+}  // namespace
+
+Image thumbnail(const Image& image, int max_side, const StretchOptions& options) {
+  if (image.empty()) throw bad_input("cannot make a thumbnail of an empty image");
+  if (max_side < 1) throw bad_input(fmt::format("thumbnail size {} is not valid: it must be >= 1 px", max_side));
+  const int longer = std::max(image.width(), image.height());
+  const int block = (longer + max_side - 1) / max_side;
+  if (block <= 1) return stretch_to_8bit(image, options);
+  Image reduced = Image::allocate((image.width() + block - 1) / block, (image.height() + block - 1) / block,
+                                  SampleType::f32);
+  switch (image.type()) {
+    case SampleType::u8: block_max<std::uint8_t>(image, block, reduced); break;
+    case SampleType::u16: block_max<std::uint16_t>(image, block, reduced); break;
+    case SampleType::f32: block_max<float>(image, block, reduced); break;
+  }
+  return stretch_to_8bit(reduced, options);
+}
+
+Image histogram_image(std::span<const std::uint32_t> counts, int width, int height) {
+  if (width < 1 || height < 1)
+    throw bad_input(fmt::format("histogram picture of {} x {} px is not valid", width, height));
+  Image out = Image::allocate(width, height, SampleType::u8);
+  if (counts.empty()) return out;
+  double top = 0;
+  for (const std::uint32_t c : counts) top = std::max(top, std::log1p(static_cast<double>(c)));
+  if (top <= 0) return out;
+  for (int x = 0; x < width; ++x) {
+    // The bins this column covers; the column shows the fullest.
+    const std::size_t first = static_cast<std::size_t>(x) * counts.size() / static_cast<std::size_t>(width);
+    const std::size_t last =
+        std::max(first + 1, static_cast<std::size_t>(x + 1) * counts.size() / static_cast<std::size_t>(width));
+    std::uint32_t c = 0;
+    for (std::size_t b = first; b < last && b < counts.size(); ++b) c = std::max(c, counts[b]);
+    if (x == width - 1) c = counts.back();  // the saturated bin always has its own column
+    if (c == 0) continue;
+    const int bar = std::max(1, static_cast<int>(std::lround(std::log1p(static_cast<double>(c)) / top * height)));
+    for (int y = height - bar; y < height; ++y) out.at<std::uint8_t>(x, y) = 255;
+  }
+  return out;
 }
 
 }  // namespace tomorig::quicklook

@@ -2,6 +2,7 @@
 // The rig configuration: cameras, trigger, calibration, voxel grid, processing and the
 // simulated scene. Parsed from TOML by load_rig_config(); every value is validated and every
 // error names the key path and line. toml++ stays inside config/src.
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -119,6 +120,40 @@ struct SimulationConfig {
   std::string light_sheet = "uniform";  // "uniform" | "gaussian" | "tophat"
 };
 
+// [quicklook], [quicklook.dt_check], [quicklook.drift], [quicklook.preview]: the targets and
+// settings of the quick-look stage (docs/quicklook.md). Every key is optional; an absent one
+// keeps the quick-look library's own default (processing/quicklook), so each parameter has its
+// default in one place. Ranges are [low, high] (green); amber bands stay the library's.
+struct QuickLookConfig {
+  std::optional<int> tile_px;
+  std::optional<double> peak_sigmas;
+  std::optional<std::array<double, 2>> ppp, diameter_px, energy_balance;
+  std::optional<double> source_density_max, saturated_fraction_max, soft_tile_fraction_max;
+
+  struct DtCheck {
+    std::optional<int> window_px;
+    std::optional<std::array<int, 2>> windows;  // along x, y
+    std::optional<double> min_peak_ratio;
+    std::optional<std::array<double, 2>> displacement_px;
+    std::optional<double> valid_fraction_min;
+  } dt_check;
+
+  struct Drift {
+    std::optional<double> warn_px;
+    std::optional<int> window_sets;
+    std::optional<std::array<int, 3>> subvolumes;  // along x, y, z
+    std::optional<double> search_radius_px;
+  } drift;
+
+  struct Preview {
+    std::optional<std::string> algorithm;  // "mlos" | "ment"
+    std::optional<int> binning;
+    std::optional<double> depth_factor;
+    std::optional<double> mlos_threshold;
+    std::optional<int> ment_iterations;
+  } preview;
+};
+
 struct RigConfig {
   std::string name = "tomorig rig";
   std::vector<CameraConfig> cameras;
@@ -127,6 +162,7 @@ struct RigConfig {
   GridConfig grid;
   ProcessingConfig processing;
   std::optional<SimulationConfig> simulation;
+  QuickLookConfig quicklook;
   std::string source_text;  // the TOML text it was parsed from
 };
 

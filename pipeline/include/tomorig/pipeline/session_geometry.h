@@ -3,6 +3,7 @@
 // session's camera order, and the voxel grid. Shared by `reconstruct`, `selfcal`, `bench
 // recon`, the back-end (run_backend) and the back-end stage of a live rig.
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -30,6 +31,10 @@ struct SessionDescription {
   std::string rig_toml;                  // as stored; empty: the recording holds no rig config
   std::optional<config::RigConfig> rig;  // parsed rig_toml; nullopt if empty or invalid
   std::string rig_error;                 // why rig_toml did not parse (raised only when the rig is needed)
+  // Where stages may store per-set quick-look numbers with the recording (the live session
+  // file being written), or empty: the recording keeps none (a session read back, a replay).
+  // Callable from a stage's own threads, until the stage's end() returns.
+  std::function<void(const storage::QuickLookRecord&)> store_quicklook;
 
   // The rig config, or nullptr if the recording holds none; throws the parse error (bad_input)
   // if it holds an invalid one.

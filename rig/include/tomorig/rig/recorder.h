@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -58,6 +59,8 @@ struct RecorderReport {
   std::uint64_t written = 0;  // sets in the session
   std::uint64_t bytes = 0;    // pixel bytes of the sets written (before compression)
   std::uint64_t refused = 0;  // sets that could not start the session or did not match it
+  std::uint64_t quicklook_rows = 0;      // quick-look records stored (add_quicklook)
+  std::uint64_t quicklook_failures = 0;  // quick-look records the file did not take
   std::string disk_full;      // why the disk stopped the recording; empty if it did not
   bool finished = false;      // the session is complete under its final name
 
@@ -83,6 +86,12 @@ class Recorder {
   // the file throws runtime_error saying how many sets were written and where they are.
   Outcome add(const FrameSet& set, const storage::TruthSet* truth = nullptr, std::string* why = nullptr);
 
+  // Stores quick-look numbers of a set with the session (storage::SessionWriter::append_quicklook):
+  // safe from a quick-look stage's threads while add() runs. Ignored before the session exists
+  // and after finish(); a failure is counted in the report (quicklook_failures), never thrown,
+  // so the quick-look cannot stop the recording.
+  void add_quicklook(const storage::QuickLookRecord& record);
+
   // Closes the session complete and returns the report. Throws runtime_error if no set ever
   // started the session ("nothing was recorded"); a recorder stopped by the disk finishes too.
   const RecorderReport& finish();
@@ -98,6 +107,7 @@ class Recorder {
   storage::SessionInfo info_;
   std::unique_ptr<storage::SessionWriter> writer_;
   RecorderReport report_;
+  std::mutex quicklook_mutex_;  // add_quicklook() against finish() and itself
 };
 
 }  // namespace tomorig::rig

@@ -3,6 +3,8 @@
 // multi-page TIFF, PNG, and whatever else OpenCV reads), for imports and calibration
 // targets, and writing PNG quick-looks. OpenCV stays inside storage/src.
 #include <filesystem>
+#include <string>
+#include <string_view>
 
 #include "tomorig/core/image.h"
 
@@ -19,5 +21,12 @@ Image read_image(const std::filesystem::path& file, int page = 0);
 // Writes a u8 or u16 image as a lossless PNG (16-bit PNG for u16), through "<file>.partial"
 // and a rename. Throws bad_input for a float image or an unwritable path.
 void write_png(const std::filesystem::path& file, const Image& image);
+
+// The same PNG as bytes in memory (for the preview stream). Throws bad_input for a float or
+// empty image.
+std::string encode_png(const Image& image);
+// A single-channel 8- or 16-bit PNG from bytes. Throws bad_input naming `what` if the bytes
+// are not such a PNG.
+Image decode_png(std::string_view bytes, std::string_view what = "PNG data");
 
 }  // namespace tomorig::storage

@@ -16,6 +16,7 @@
 #include "tomorig/core/frame_set.h"
 #include "tomorig/core/geometry.h"
 #include "tomorig/core/pixel_format.h"
+#include "tomorig/storage/quicklook_record.h"
 
 namespace tomorig::storage {
 
@@ -139,6 +140,13 @@ class SessionWriter {
   // Truth of simulated sessions: write_truth once, write_truth_set once per set index.
   void write_truth(const SessionTruth& truth);
   void write_truth_set(std::uint64_t set_index, const TruthSet& truth);
+  // Quick-look numbers of one set (/quicklook, quicklook_record.h), e.g. from a quick-look
+  // stage: safe to call from another thread while append() runs. Records may come late, skip
+  // sets and arrive out of order; each names its set, and several may name the same set (what
+  // is not measured in one is NaN there; quicklook() merges them). In a live recording they become visible
+  // with the next flush. Throws bad_input for a record whose camera count is not the
+  // session's; an HDF5 failure throws runtime, as append() does.
+  void append_quicklook(const QuickLookRecord& record);
   // Flushes, closes and renames the partial file to the final path.
   void finish();
 
@@ -183,6 +191,11 @@ class SessionReader {
   bool has_truth_set(std::uint64_t set_index) const;
   std::uint64_t truth_set_count() const;                   // sets with /truth/sets/<index>
   TruthSet truth_set(std::uint64_t set_index) const;       // bad_input if absent
+  // The quick-look numbers stored with the session, one record per set in set order (rows of
+  // the same set, e.g. its statistics and, later, its preview volume, merged: measured figures
+  // fill unmeasured ones, flags take the worse); empty if none (sessions recorded without a
+  // quick-look, or before tomorig stored them).
+  std::vector<QuickLookRecord> quicklook() const;
 
  private:
   struct Impl;

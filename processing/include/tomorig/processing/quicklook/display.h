@@ -1,6 +1,10 @@
 #pragma once
 // Quick-look images for people: a raw frame or a volume projection stretched to 8 bits so the
 // seeding, the spray or the light sheet can be judged at a glance in any image viewer.
+#include <cstdint>
+#include <span>
+#include <string>
+
 #include "tomorig/core/image.h"
 #include "tomorig/core/volume.h"
 
@@ -27,5 +31,19 @@ enum class Axis { x, y, z };
 // high (row j, column i), along y nx x nz, along x ny x nz. Zero where no voxel is active.
 Image max_projection(const SparseVolume& volume, Axis axis);
 Image max_projection(const DenseVolume& volume, Axis axis);
+
+// A small 8-bit picture of a frame for the preview stream: `image` reduced by whole blocks to at
+// most `max_side` pixels on its longer side, each block keeping its brightest pixel (so that
+// particle images survive the reduction), then stretched as stretch_to_8bit does.
+Image thumbnail(const Image& image, int max_side, const StretchOptions& options = {});
+
+// A `width` x `height` 8-bit bar chart of histogram `counts` on a log scale (white bars on
+// black; an empty bin leaves its column black). The last column is the last bin: with the
+// quick-look's display histogram, the saturated pixels.
+Image histogram_image(std::span<const std::uint32_t> counts, int width, int height);
+
+// `image` (8-bit) with `lines` of text written under it in a black band, white, one line per
+// entry; the picture is widened if a line needs more room. For snapshots with their numbers.
+Image with_caption(const Image& image, std::span<const std::string> lines);
 
 }  // namespace tomorig::quicklook

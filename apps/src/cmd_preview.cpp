@@ -1,0 +1,98 @@
+// tomorig preview: watches the quick-look results a running rig (tomorig run --preview) or a
+// replay (tomorig replay --preview) publishes. A terminal view refreshed in place, plain lines
+// when stdout is not a terminal, one JSON line per set with --json, snapshots with --png.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+#include <zmq.hpp>
+
+#include "commands.h"
+#include "tomorig/core/error.h"
+#include "tomorig/pipeline/quicklook_view.h"
+#include "tomorig/rig/stop_signal.h"
+#include "tomorig/stream/preview.h"
+
+namespace tomorig::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using namespace std::chrono_literals;
+
+struct PreviewArgs {
+  std::string from = stream::kDefaultPreviewEndpoint;
+  pipeline::QuickLookViewOptions view;
+  std::string png;
+  std::uint64_t count = 0;  // stop after this many sets; 0: until Ctrl-C
+  double timeout_s = 0;     // give up after this long without a message; 0: wait for ever
+};
+
+void watch(PreviewArgs args) {
+  if (!(args.timeout_s >= 0)) throw bad_input(fmt::format("--timeout {:g} is invalid: it must be >= 0 seconds", args.timeout_s));
+  if (!(args.view.png_interval_s >= 0))
+    throw bad_input(fmt::format("--png-interval {:g} is invalid: it must be >= 0 seconds", args.view.png_interval_s));
+  args.view.png_folder = args.png;
+  args.view.source = args.from;
+  args.view.tty = !args.view.json && isatty(STDOUT_FILENO) == 1;
+  pipeline::QuickLookView view(args.view);
+
+  zmq::context_t context(1);
+  stream::SocketOptions socket = stream::preview_socket_options(args.from);
+  socket.endpoint.bind = false;
+  socket.timeout = 250ms;  // wakes up to notice Ctrl-C and --timeout
+  stream::PreviewSubscriber subscriber(context, socket);
+  fmt::print(stderr, "preview: listening on {}{}\n", args.from,
+             args.count > 0 ? fmt::format(" for {} sets", args.count) : std::string(" (Ctrl-C ends)"));
+
+  const rig::StopSignalGuard stop;
+  auto last_message = Clock::now();
+  while (!stop.stop_requested() && (args.count == 0 || view.sets() < args.count)) {
+    std::optional<stream::PreviewMessage> message;
+    try {
+      message = subscriber.receive_message();
+    } catch (const zmq::error_t& e) {
+      if (e.num() == EINTR) continue;
+      throw runtime_error(fmt::format("the preview stream from {} failed: {}", args.from, e.what()));
+    }
+    if (!message) {
+      if (args.timeout_s > 0 && std::chrono::duration<double>(Clock::now() - last_message).count() > args.timeout_s)
+        throw runtime_error(fmt::format("no quick-look results arrived from {} in {:g} s: is 'tomorig run --preview' "
+                                        "or 'tomorig replay --preview' publishing there?",
+                                        args.from, args.timeout_s));
+      continue;
+    }
+    last_message = Clock::now();
+    const std::string text = view.take(*message);
+    fmt::print("{}", text);
+    std::fflush(stdout);
+  }
+  fmt::print(stderr, "preview: {} sets shown{}\n", view.sets(),
+             view.snapshots().empty() ? std::string()
+                                      : fmt::format(", {} snapshots in {}", view.snapshots().size(), args.png));
+}
+
+}  // namespace
+
+void add_preview_command(CLI::App& root) {
+  auto args = std::make_shared<PreviewArgs>();
+  CLI::App* cmd = root.add_subcommand(
+      "preview", "Watch the quick-look of a running rig or replay: seeding, illumination, dt, alignment, light sheet");
+  cmd->add_option("--from", args->from, "Preview endpoint to connect to (tomorig run --preview publishes there)")
+      ->capture_default_str();
+  cmd->add_flag("--json", args->view.json, "Print one JSON line per set (for scripts) instead of the view");
+  cmd->add_option("--png", args->png, "Write snapshots with their numbers to this folder (created if needed)");
+  cmd->add_option("--png-interval", args->view.png_interval_s, "Seconds between snapshots; 0: one per set")
+      ->capture_default_str();
+  cmd->add_flag("--overwrite", args->view.overwrite, "Replace snapshots already in the --png folder");
+  cmd->add_option("--count", args->count, "Stop after this many sets (default: until Ctrl-C)");
+  cmd->add_option("--timeout", args->timeout_s,
+                  "Give up (exit 1) after this many seconds without a message (default: wait for ever)");
+  cmd->callback([args] { watch(*args); });
+}
+
+}  // namespace tomorig::app

@@ -1,0 +1,175 @@
+// tomorig bench quicklook: issue 16's throughput case. Sets of N cameras x side^2 Mono16 double
+// frames (default 4 x 2048^2, 64 MiB a set) fed at the rig's rate (default 10 Hz) into a chain
+// of the recorder (every set, into a live session file) and the quick-look stage (statistics,
+// Δt check, preview volume, drift alarm, published on the preview stream), as `tomorig run
+// --preview` feeds them. A few simulated sets (the tpiv-thesis scene through larger sensors)
+// are rendered once and fed in turn, so rendering costs nothing during the measurement.
+//
+// What it reports: sets the recorder wrote against sets fed (loss), sets fed late (the recorder
+// held the feed back by more than one period: on a live rig, frames the cameras would drop),
+// the quick-look's sets analysed and skipped, its milliseconds per camera frame, the preview
+// volumes made and passed over with the latency of the last one, and the process's CPU share.
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+
+#include "bench_common.h"
+#include "tomorig/config/rig_config.h"
+#include "tomorig/core/error.h"
+#include "tomorig/pipeline/session_geometry.h"
+#include "tomorig/pipeline/stage_chain.h"
+#include "tomorig/pipeline/stage_registry.h"
+#include "tomorig/rig/rig_stages.h"
+#include "tomorig/rig/simulate_session.h"
+#include "tomorig/simulators/simulated_rig.h"
+
+namespace tomorig::bench {
+namespace {
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+struct BenchQuickLookArgs {
+  int cameras = 4;
+  int side = 2048;
+  double rate_hz = 10.0;
+  int sets = 50;
+  int distinct = 2;
+  std::string preview = "on";
+  std::string publish = "tcp://127.0.0.1:*";
+  std::string folder = ".";
+  std::string json_out;
+};
+
+// The tpiv-thesis rig with `side` x `side` sensors whose pixels are smaller by the same factor,
+// so the cameras see the same field of view and the same particles.
+std::string rig_toml(const BenchQuickLookArgs& a) {
+  const double yaws[] = {-42.0, -14.0, 14.0, 42.0, -28.0, 28.0, 0.0, -56.0};
+  std::string toml = "name = \"bench quicklook\"\n";
+  for (int c = 0; c < a.cameras; ++c)
+    toml += fmt::format(
+        "[[cameras]]\nid = \"cam{0}\"\nbackend = \"simulated\"\npixel_format = \"Mono16\"\npixel_pitch_um = {1}\n"
+        "yaw_deg = {2}\n[cameras.roi]\nwidth = {3}\nheight = {3}\n",
+        c, 7.4 * 512.0 / a.side, yaws[c % 8], a.side);
+  toml += fmt::format("[trigger]\nbackend = \"simulated\"\nrate_hz = {}\n", a.rate_hz);
+  toml += "[simulation]\ncase = \"tpiv-thesis\"\nppp = 0.05\nnoise = true\n";
+  return toml;
+}
+
+void run(const BenchQuickLookArgs& args) {
+  if (args.cameras < 1 || args.cameras > 8 || args.side < 64 || args.sets < 1 || args.distinct < 1 ||
+      !(args.rate_hz > 0))
+    throw bad_input("bench quicklook needs --cameras 1 to 8, --side >= 64, --sets >= 1, --distinct >= 1, --rate > 0");
+  if (!fs::is_directory(args.folder)) throw bad_input(fmt::format("--folder '{}' is not a folder", args.folder));
+  const config::RigConfig rig = config::parse_rig_config(rig_toml(args), "bench quicklook rig");
+  const sim::SimulatedRig simulated(rig::simulation_options_from(rig));
+
+  fmt::print(stderr, "bench quicklook: rendering {} sets of {} x {}^2 ...\n", args.distinct, args.cameras, args.side);
+  std::vector<FrameSet> sets;
+  for (int k = 0; k < args.distinct; ++k) sets.push_back(simulated.render_set(static_cast<std::uint64_t>(k)).frames);
+  std::vector<storage::SessionCamera> cameras;
+  storage::SessionTruth truth;
+  truth.case_name = "tpiv-thesis";
+  for (const sim::SimulatedCamera& c : simulated.cameras()) {
+    cameras.push_back({c.spec.id, c.spec.width, c.spec.height, PixelFormat::Mono16, c.spec.pixel_pitch_um});
+    truth.cameras.push_back(rig::truth_camera_of(c));
+  }
+
+  const fs::path out = fs::path(args.folder) / "tomorig-bench-quicklook.h5";
+  const std::vector<pipeline::StageSpec> specs = {
+      pipeline::parse_stage_spec(fmt::format("recorder:out={},overwrite=true", out.string())),
+      pipeline::parse_stage_spec(fmt::format("quicklook:preview={},publish={}", args.preview, args.publish))};
+  pipeline::StageChain chain = pipeline::make_chain(rig::all_stages(), specs);
+  chain.begin(pipeline::describe_recording("bench quicklook", cameras, rig.source_text, truth));
+
+  const double period = 1.0 / args.rate_hz;
+  fmt::print(stderr, "bench quicklook: feeding {} sets ({} MiB each) at {:g} Hz ...\n", args.sets,
+             set_bytes(sets[0]) >> 20, args.rate_hz);
+  const double cpu0 = process_cpu_seconds();
+  const auto start = Clock::now();
+  int late = 0;
+  double worst_lateness = 0;
+  for (int s = 0; s < args.sets; ++s) {
+    const auto due = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s * period));
+    std::this_thread::sleep_until(due);
+    const double lateness = std::chrono::duration<double>(Clock::now() - due).count();
+    worst_lateness = std::max(worst_lateness, lateness);
+    if (lateness > period) ++late;
+    FrameSet set = sets[static_cast<std::size_t>(s % args.distinct)];  // shares the pixels
+    set.set_index = set.trigger_index = static_cast<std::uint64_t>(s);
+    set.trigger_timestamp_ns = static_cast<std::int64_t>(s * period * 1e9);
+    chain.push(set);
+  }
+  const double feed_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  const std::vector<pipeline::StageReport> reports = chain.end();
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  const double cpu = process_cpu_seconds() - cpu0;
+  std::error_code ec;
+  fs::remove(out, ec);
+
+  const pipeline::StageReport& recorder = reports.at(0);
+  const pipeline::StageReport& quicklook = reports.at(1);
+  const auto written = recorder.status.value("written", std::uint64_t{0});
+  const double frames = static_cast<double>(quicklook.processed) * args.cameras * 2;
+  const nlohmann::json result = {
+      {"bench", "quicklook"},
+      {"machine", machine_json()},
+      {"cameras", args.cameras},
+      {"side", args.side},
+      {"rate_hz", args.rate_hz},
+      {"set_bytes", set_bytes(sets[0])},
+      {"sets_fed", args.sets},
+      {"feed_seconds", feed_seconds},
+      {"seconds", seconds},
+      {"recorder",
+       {{"written", written},
+        {"lost", static_cast<std::uint64_t>(args.sets) - written},
+        {"late_sets", late},
+        {"worst_lateness_s", worst_lateness},
+        {"busy_seconds", recorder.busy_seconds},
+        {"error", recorder.error}}},
+      {"quicklook",
+       {{"analysed", quicklook.processed},
+        {"skipped", quicklook.skipped},
+        {"busy_seconds", quicklook.busy_seconds},
+        {"ms_per_camera_frame", frames > 0 ? json_number(quicklook.busy_seconds / frames * 1e3) : nullptr},
+        {"status", quicklook.status},
+        {"error", quicklook.error}}},
+      {"cpu_seconds", cpu},
+      {"cpu_share", cpu / seconds / std::max(1u, std::thread::hardware_concurrency())},
+  };
+  fmt::print(stderr,
+             "bench quicklook: recorder wrote {} of {} sets ({} late); quick-look analysed {} ({} skipped), {:.1f} ms "
+             "per camera frame; CPU share {:.0f} %\n",
+             written, args.sets, late, quicklook.processed, quicklook.skipped,
+             frames > 0 ? quicklook.busy_seconds / frames * 1e3 : 0.0, 100.0 * result["cpu_share"].get<double>());
+  write_json(result, args.json_out);
+}
+
+}  // namespace
+
+void add_bench_quicklook_command(CLI::App& bench) {
+  auto args = std::make_shared<BenchQuickLookArgs>();
+  CLI::App* cmd = bench.add_subcommand(
+      "quicklook", "Recorder plus quick-look at the rig's rate: loss, late sets, ms per camera frame, CPU share");
+  cmd->add_option("--cameras", args->cameras, "Cameras per set")->capture_default_str();
+  cmd->add_option("--side", args->side, "Frame width and height, pixels (Mono16)")->capture_default_str();
+  cmd->add_option("--rate", args->rate_hz, "Sets per second fed")->capture_default_str();
+  cmd->add_option("--sets", args->sets, "Sets fed (each is written: sets x 64 MiB at the defaults)")
+      ->capture_default_str();
+  cmd->add_option("--distinct", args->distinct, "Different simulated sets rendered and fed in turn")
+      ->capture_default_str();
+  cmd->add_option("--preview", args->preview, "Preview volume: on, off, mlos or ment")->capture_default_str();
+  cmd->add_option("--publish", args->publish, "Where the quick-look publishes (none: nowhere)")->capture_default_str();
+  cmd->add_option("--folder", args->folder, "Folder for the recorded session (removed after)")->capture_default_str();
+  cmd->add_option("--json", args->json_out, "Write the JSON here ('-' or empty: stdout)");
+  cmd->callback([args] { run(*args); });
+}
+
+}  // namespace tomorig::bench

@@ -1,0 +1,226 @@
+// quicklook: issue 16's online processing as a stage. Per set it sees, per camera: the
+// quick-look statistics of both frames and the Δt check; on its own thread, for the newest set
+// it can keep up with: the preview volume and the drift monitor. Results go out on the preview
+// PUB stream (JSON plus small images) and into the session file being recorded (/quicklook).
+// It may skip sets to stay current; the sets it never saw and the sets the preview passed over
+// are counted. Targets come from the rig file's [quicklook] tables (docs/quicklook.md).
+//
+//   --stage quicklook                                  statistics, preview, drift; stored, not published
+//   --stage quicklook:publish=tcp://127.0.0.1:5557     and published (tomorig run --preview does this)
+//   --stage quicklook:preview=off                      statistics and Δt check only
+//   --stage quicklook:preview=ment,threads=2           MENT previews on two threads
+#include <chrono>
+#include <memory>
+#include <mutex>
+#include <optional>
+
+#include <fmt/format.h>
+#include <zmq.hpp>
+
+#include "preview_worker.h"
+#include "quicklook_report.h"
+#include "tomorig/core/error.h"
+#include "tomorig/pipeline/quicklook_settings.h"
+#include "tomorig/pipeline/session_geometry.h"
+#include "tomorig/pipeline/stage.h"
+
+namespace tomorig::pipeline {
+namespace {
+
+using namespace quicklook_stage;
+using Clock = std::chrono::steady_clock;
+
+class QuickLookStage final : public Stage {
+ public:
+  void configure(const StageTable& table) override {
+    publish_ = table.text("publish", publish_);
+    allow_remote_ = table.flag("allow_remote", allow_remote_);
+    store_ = table.flag("store", store_);
+    preview_ = table.text("preview", preview_);
+    if (preview_ != "on" && preview_ != "off" && preview_ != "mlos" && preview_ != "ment")
+      throw bad_input(fmt::format("stage 'quicklook': preview = {} is not one of on, off, mlos, ment", preview_));
+    if (table.has("threads")) threads_ = static_cast<int>(table.integer("threads", 0));
+    thumbnail_px_ = static_cast<int>(table.integer("thumbnail_px", thumbnail_px_));
+    if (thumbnail_px_ < 16 || thumbnail_px_ > 1024)
+      throw bad_input(fmt::format("stage 'quicklook': thumbnail_px = {} is out of range: use 16 to 1024", thumbnail_px_));
+    calib_ = table.text("calib", calib_);
+    // Bound now, so a taken or forbidden address fails before the rig is armed.
+    if (!publish_.empty() && publish_ != "none") {
+      stream::SocketOptions options = stream::preview_socket_options(publish_);
+      options.endpoint.allow_remote = allow_remote_;
+      publisher_ = std::make_unique<stream::PreviewPublisher>(context_, options);
+    }
+  }
+
+  void begin(const SessionDescription& recording) override {
+    QuickLookSettings settings = quicklook_settings(recording.rig_config());
+    if (preview_ == "mlos" || preview_ == "ment") settings.preview.algorithm = preview_;
+    if (threads_) settings.preview.threads = *threads_;
+    settings.preview.validate();
+    settings.store = store_;
+    settings.thumbnail_px = thumbnail_px_;
+    settings_ = settings;
+    store_quicklook_ = store_ ? recording.store_quicklook : nullptr;
+
+    for (const storage::SessionCamera& camera : recording.cameras) {
+      quicklook::QuickLookOptions options = settings.statistics;
+      options.bit_depth = bit_depth(camera.pixel_format);
+      statistics_.emplace_back(options);
+      dt_checks_.emplace_back(settings.dt_check);
+      results_.push_back({.id = camera.id});
+    }
+    if (preview_ != "off") start_preview(recording, settings);
+  }
+
+  void process(const FrameSet& set) override {
+    const auto taken = Clock::now();
+    if (set.cameras.size() != results_.size())
+      throw bad_input(fmt::format("stage 'quicklook': set {} has {} cameras but the recording has {}", set.set_index,
+                                  set.cameras.size(), results_.size()));
+    if (seen_any_ && set.set_index > last_set_ + 1) counts_.skipped += set.set_index - last_set_ - 1;
+    seen_any_ = true;
+    last_set_ = set.set_index;
+
+    std::vector<double> backgrounds(results_.size(), quicklook::not_measured);
+    for (std::size_t c = 0; c < results_.size(); ++c) {
+      CameraResult& r = results_[c];
+      const CameraFrames& frames = set.cameras[c];
+      r.measured = frames.a.present() && frames.b.present();
+      r.missing = r.measured ? "" : frames.a.present() ? "frame B missing" : "frame A missing";
+      if (!r.measured) continue;
+      // A frame these kernels cannot take (too small, float) is reported for its camera; it
+      // does not stop the quick-look of the others.
+      try {
+        statistics_[c].analyse(frames.a.image, frames.b.image, r.statistics);
+        backgrounds[c] = r.statistics.a.background;
+      } catch (const Error& e) {
+        r.measured = false;
+        r.missing = e.what();
+        continue;
+      }
+      try {
+        dt_checks_[c].check(frames.a.image, frames.b.image, r.dt_check);
+      } catch (const Error&) {
+        r.dt_check = {};  // not measured: null figures, red
+      }
+    }
+    ++counts_.analysed;
+
+    PreviewSummary preview;
+    DriftSummary drift;
+    if (worker_) {
+      const PreviewWorker::State s = worker_->state();
+      preview = s.preview;
+      drift = s.drift;
+      counts_.previews = s.previews;
+      counts_.previews_skipped = s.skipped;
+      counts_.drift_alarm_sets = s.drift_alarm_sets;
+    }
+    if (publisher_) publish(set_message(set, results_, preview, drift, counts_, settings_.thumbnail_px));
+    if (store_quicklook_) {
+      store_quicklook_(statistics_record(set.set_index, results_));
+      ++counts_.stored;
+    }
+    if (worker_) worker_->offer({set, std::move(backgrounds), taken});
+  }
+
+  void end() override {
+    if (worker_) {
+      worker_->finish();
+      const PreviewWorker::State s = worker_->state();
+      counts_.previews = s.previews;
+      counts_.previews_skipped = s.skipped;
+      counts_.drift_alarm_sets = s.drift_alarm_sets;
+      final_state_ = s;
+    }
+  }
+
+  nlohmann::json status() const override {
+    nlohmann::json j = to_json(counts_);
+    {
+      std::lock_guard lock(publish_mutex_);
+      j["published"] = published_;
+      j["dropped"] = dropped_;
+    }
+    j["publish"] = publisher_ ? nlohmann::json(publisher_->endpoint()) : nlohmann::json(nullptr);
+    const PreviewWorker::State s = worker_ ? worker_->state() : final_state_;
+    j["preview"] = preview_ == "off"        ? nlohmann::json("off")
+                   : !s.disabled.empty() ? nlohmann::json(fmt::format("off: {}", s.disabled))
+                                         : nlohmann::json(settings_.preview.algorithm);
+    j["preview_failures"] = s.failures;
+    if (!s.last_error.empty()) j["preview_error"] = s.last_error;
+    j["preview_latency_s"] = {{"max", s.latency_max_s},
+                              {"mean", s.previews > 0 ? nlohmann::json(s.latency_sum_s / static_cast<double>(s.previews))
+                                                      : nlohmann::json(nullptr)}};
+    j["latest_preview"] = to_json(s.preview);
+    j["latest_drift"] = to_json(s.drift);
+    return j;
+  }
+
+  bool may_skip() const override { return true; }
+
+ private:
+  // The preview volume and drift monitor need the cameras' models: the truth of a simulated
+  // recording, or the rig's calibration. Without them the statistics still run. They are built
+  // on the preview thread, so that begin() (on the recorder's thread) returns at once.
+  void start_preview(const SessionDescription& recording, const QuickLookSettings& settings) {
+    auto build = [recording, settings, calib = calib_]() {
+      PreviewWorker::Parts parts;
+      const SessionCameras cameras = session_cameras(recording, calib);
+      const VoxelGrid grid = grid_from_session(recording);
+      std::vector<calibration::ImageSize> sizes;
+      for (const storage::SessionCamera& c : recording.cameras) sizes.push_back({c.width, c.height});
+      parts.preview = std::make_unique<quicklook::PreviewVolume>(cameras.models, sizes, grid, settings.preview);
+      if (cameras.models.size() >= 3) {
+        quicklook::DriftOptions options = settings.drift;
+        for (const storage::SessionCamera& c : recording.cameras) options.camera_names.push_back(c.id);
+        const Vec3d low = grid.centre_of(-0.5, -0.5, -0.5);
+        const Vec3d high = grid.centre_of(grid.nx - 0.5, grid.ny - 0.5, grid.nz - 0.5);
+        parts.drift = std::make_unique<quicklook::DriftMonitor>(cameras.models, sizes,
+                                                                calibration::VolumeBounds{low, high}, options);
+      }
+      return parts;
+    };
+    PreviewWorker::Outputs outputs;
+    if (publisher_) outputs.publish = [this](stream::PreviewMessage m) { publish(m); };
+    if (store_quicklook_) outputs.store = store_quicklook_;
+    worker_ = std::make_unique<PreviewWorker>(std::move(build), recording.cameras.size(), std::move(outputs));
+  }
+
+  // Both threads publish: one socket, used by one at a time.
+  void publish(const stream::PreviewMessage& message) {
+    std::lock_guard lock(publish_mutex_);
+    if (publisher_->publish(message)) ++published_;
+    else ++dropped_;
+  }
+
+  std::string publish_;
+  bool allow_remote_ = false;
+  bool store_ = true;
+  std::string preview_ = "on";
+  std::optional<int> threads_;
+  int thumbnail_px_ = QuickLookSettings{}.thumbnail_px;
+  std::string calib_;
+
+  QuickLookSettings settings_;
+  std::function<void(const storage::QuickLookRecord&)> store_quicklook_;
+  std::vector<quicklook::QuickLook> statistics_;
+  std::vector<quicklook::DtCheck> dt_checks_;
+  std::vector<CameraResult> results_;
+  Counts counts_;
+  bool seen_any_ = false;
+  std::uint64_t last_set_ = 0;
+  std::unique_ptr<PreviewWorker> worker_;
+  PreviewWorker::State final_state_;
+
+  zmq::context_t context_{1};
+  std::unique_ptr<stream::PreviewPublisher> publisher_;
+  mutable std::mutex publish_mutex_;
+  std::uint64_t published_ = 0, dropped_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<Stage> make_quicklook_stage() { return std::make_unique<QuickLookStage>(); }
+
+}  // namespace tomorig::pipeline
