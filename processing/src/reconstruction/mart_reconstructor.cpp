@@ -54,10 +54,8 @@ class MartReconstructor final : public Reconstructor {
   explicit MartReconstructor(const ReconstructionOptions& options) : options_(options) {}
   std::string name() const override { return "mart"; }
 
-  SparseVolume reconstruct(const ReconstructionInput& input, ReconstructionReport& report) override {
-    const auto start = std::chrono::steady_clock::now();
-    report = {};
-    report.algorithm = name();
+ protected:
+  SparseVolume run(const ReconstructionInput& input, ReconstructionReport& report) override {
     SupportNeeds needs;
     needs.mlos_threshold = 0.0;
     needs.positions = true;
@@ -68,7 +66,7 @@ class MartReconstructor final : public Reconstructor {
     std::vector<RayTable> rays;
     for (std::size_t c = 0; c < system.cameras(); ++c) rays.push_back(rays_of(system, c));
     std::vector<float> e(system.voxels(), 1.0f);
-    report.setup_seconds = seconds_since(start);
+    report.setup_seconds = elapsed_seconds();
     report.threads = 1;  // ray by ray: sequential by definition
 
     const double mu = options_.relaxation;
@@ -100,7 +98,6 @@ class MartReconstructor final : public Reconstructor {
         break;
     }
     SparseVolume volume = to_volume(s.in.grid, s.set.index, e);
-    finish_report(report, start, volume);
     return volume;
   }
 

@@ -83,10 +83,8 @@ class MentReconstructor final : public Reconstructor {
   explicit MentReconstructor(const ReconstructionOptions& options) : options_(options) {}
   std::string name() const override { return "ment"; }
 
-  SparseVolume reconstruct(const ReconstructionInput& input, ReconstructionReport& report) override {
-    const auto start = std::chrono::steady_clock::now();
-    report = {};
-    report.algorithm = name();
+ protected:
+  SparseVolume run(const ReconstructionInput& input, ReconstructionReport& report) override {
     in_ = prepare_input(input, options_);
     report.threads = in_.threads;
     const std::size_t cams = in_.camera_count();
@@ -97,7 +95,7 @@ class MentReconstructor final : public Reconstructor {
     samples_ = build_ment_samples(in_, projector, measured_, codec_, options_.mlos_threshold, budget);
     // The normalised images are now in measured_; the float copies are not needed any more.
     for (CameraImage& im : in_.images) im.pixels = {};
-    report.setup_seconds = seconds_since(start);
+    report.setup_seconds = elapsed_seconds();
 
     for (int it = 1; it <= options_.max_iterations; ++it) {
       const auto t0 = std::chrono::steady_clock::now();
@@ -116,7 +114,6 @@ class MentReconstructor final : public Reconstructor {
 
     SparseVolume volume = recover_volume(report);
     report.active_voxels = volume.size();
-    finish_report(report, start, volume);
     in_ = {};
     samples_ = {};
     pseudo_.clear();

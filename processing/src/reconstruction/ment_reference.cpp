@@ -33,7 +33,7 @@
 #include <omp.h>
 
 #include "grid_projector.h"
-#include "tomorig/processing/reconstruction/ment_reference.h"
+#include "ment_reference.h"
 #include "prepared_input.h"
 #include "support.h"
 #include "system_memory.h"
@@ -130,10 +130,8 @@ class DenseMentReconstructor final : public Reconstructor {
   explicit DenseMentReconstructor(const ReconstructionOptions& options) : options_(options) {}
   std::string name() const override { return "ment-dense-reference"; }
 
-  SparseVolume reconstruct(const ReconstructionInput& input, ReconstructionReport& report) override {
-    const auto start = std::chrono::steady_clock::now();
-    report = {};
-    report.algorithm = name();
+ protected:
+  SparseVolume run(const ReconstructionInput& input, ReconstructionReport& report) override {
     in_ = prepare_input(input, options_);
     report.threads = in_.threads;
     const std::size_t cams = in_.camera_count();
@@ -141,7 +139,7 @@ class DenseMentReconstructor final : public Reconstructor {
     check_memory(report);
     const GridProjector projector(in_);
     make_planes();
-    report.setup_seconds = seconds_since(start);
+    report.setup_seconds = elapsed_seconds();
 
     for (int it = 1; it <= options_.max_iterations; ++it) {
       const auto t0 = std::chrono::steady_clock::now();
@@ -165,7 +163,6 @@ class DenseMentReconstructor final : public Reconstructor {
 
     SparseVolume volume = recover_volume(projector, report);
     report.active_voxels = volume.size();
-    finish_report(report, start, volume);
     in_ = {};
     pseudo_.clear();
     measured_.clear();

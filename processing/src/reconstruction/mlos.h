@@ -8,11 +8,14 @@
 #include "active_set.h"
 #include "grid_projector.h"
 #include "prepared_input.h"
+#include "tomorig/processing/reconstruction/reconstructor.h"
 
 namespace tomorig::recon::detail {
 
 struct MlosSettings {
-  double threshold = 0.05;      // fraction of each image's maximum below which a pixel is empty
+  // Fraction of each image's maximum below which a pixel is empty (default: the one in
+  // ReconstructionOptions).
+  double threshold = ReconstructionOptions{}.mlos_threshold;
   // Memory check while the support grows: refuse once fixed + per_voxel * active exceeds it.
   double fixed_bytes = 0.0;
   double bytes_per_voxel = 0.0;

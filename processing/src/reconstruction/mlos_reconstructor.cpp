@@ -13,10 +13,8 @@ class MlosReconstructor final : public Reconstructor {
   explicit MlosReconstructor(const ReconstructionOptions& options) : options_(options) {}
   std::string name() const override { return "mlos"; }
 
-  SparseVolume reconstruct(const ReconstructionInput& input, ReconstructionReport& report) override {
-    const auto start = std::chrono::steady_clock::now();
-    report = {};
-    report.algorithm = name();
+ protected:
+  SparseVolume run(const ReconstructionInput& input, ReconstructionReport& report) override {
     SupportNeeds needs;
     needs.mlos_threshold = options_.mlos_threshold;
     needs.positions = false;
@@ -31,7 +29,6 @@ class MlosReconstructor final : public Reconstructor {
     } else {
       volume = to_volume(s.in.grid, s.set.index, s.set.value);
     }
-    finish_report(report, start, volume);
     return volume;
   }
 

@@ -63,11 +63,9 @@ class MultiplicativeReconstructor final : public Reconstructor {
       : options_(options), schedule_(schedule) {}
   std::string name() const override { return schedule_ == Schedule::by_camera ? "fmart" : "smart"; }
 
-  SparseVolume reconstruct(const ReconstructionInput& input, ReconstructionReport& report) override {
-    const auto start = std::chrono::steady_clock::now();
+ protected:
+  SparseVolume run(const ReconstructionInput& input, ReconstructionReport& report) override {
     StageTimer timer(schedule_ == Schedule::by_camera ? "fmart" : "smart");
-    report = {};
-    report.algorithm = name();
     SupportNeeds needs;
     needs.mlos_threshold = options_.mlos_threshold;
     needs.positions = true;
@@ -89,21 +87,9 @@ class MultiplicativeReconstructor final : public Reconstructor {
     std::vector<float> acc(schedule_ == Schedule::simultaneous ? e.size() : 0);
     timer.mark("sparse system");
 
-    double observer_time = 0.0;
-    auto elapsed = [&] { return seconds_since(start) - observer_time; };
-    auto notify = [&](int iteration, const IterationStats* stats) {
-      if (!observer_) return;
-      const auto t0 = std::chrono::steady_clock::now();
-      IterationView view;
-      view.iteration = iteration;
-      view.stats = stats;
-      view.elapsed_seconds = elapsed();
-      view.volume = [&] { return to_volume(s.in.grid, index, e); };
-      observer_(view);
-      observer_time += seconds_since(t0);
-    };
-    report.setup_seconds = elapsed();
-    notify(0, nullptr);
+    auto current_volume = [&] { return to_volume(s.in.grid, index, e); };
+    report.setup_seconds = elapsed_seconds();
+    notify(0, nullptr, current_volume);
 
     const float mu = static_cast<float>(options_.relaxation);
     const std::size_t cams = system.cameras();
@@ -140,16 +126,13 @@ class MultiplicativeReconstructor final : public Reconstructor {
       if (options_.prune_fraction > 0) prune(system, index, e, acc, threads);
       const bool stop = record_iteration(report, it, measured > 0 ? diff / measured : 0.0, update_sum / updates,
                                          seconds_since(t0), options_.stop_mean_update);
-      report.history.back().elapsed_seconds = elapsed();
+      report.history.back().elapsed_seconds = elapsed_seconds();
       report.history.back().live_voxels = e.size();
       timer.mark("iteration");
-      notify(it, &report.history.back());
+      notify(it, &report.history.back(), current_volume);
       if (stop) break;
     }
     SparseVolume volume = to_volume(s.in.grid, index, e);
-    finish_report(report, start, volume);
-    report.observer_seconds = observer_time;
-    report.seconds -= observer_time;
     timer.mark("output");
     return volume;
   }

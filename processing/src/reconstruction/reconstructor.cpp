@@ -6,6 +6,7 @@
 
 #include "algorithms.h"
 #include "ment.h"
+#include "system_memory.h"
 #include "tomorig/core/error.h"
 
 namespace tomorig::recon {
@@ -36,6 +37,39 @@ void ReconstructionOptions::validate() const {
   if (threads < 0) throw bad_input(fmt::format("reconstruction: threads = {} must be >= 0 (0: default)", threads));
   if (!(memory_limit_mb >= 0) || !std::isfinite(memory_limit_mb))
     throw bad_input(fmt::format("reconstruction: memory_limit_mb = {} must be >= 0 (0: MemAvailable)", memory_limit_mb));
+}
+
+namespace {
+double seconds_from(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+}  // namespace
+
+SparseVolume Reconstructor::reconstruct(const ReconstructionInput& input, ReconstructionReport& report) {
+  start_ = std::chrono::steady_clock::now();
+  observer_seconds_ = 0.0;
+  report = {};
+  report.algorithm = name();
+  SparseVolume volume = run(input, report);
+  report.nonzero_voxels = volume.size();
+  report.observer_seconds = observer_seconds_;
+  report.seconds = elapsed_seconds();
+  report.peak_rss_mb = detail::peak_rss_mb();
+  return volume;
+}
+
+double Reconstructor::elapsed_seconds() const { return seconds_from(start_) - observer_seconds_; }
+
+void Reconstructor::notify(int iteration, const IterationStats* stats, std::function<SparseVolume()> volume) {
+  if (!observer_) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  IterationView view;
+  view.iteration = iteration;
+  view.stats = stats;
+  view.elapsed_seconds = elapsed_seconds();
+  view.volume = std::move(volume);
+  observer_(view);
+  observer_seconds_ += seconds_from(t0);
 }
 
 std::string algorithm_names() { return "mlos, ment, mart, smart, fmart"; }

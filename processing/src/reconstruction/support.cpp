@@ -105,11 +105,5 @@ bool record_iteration(ReconstructionReport& report, int iteration, double residu
   return stop_mean_update > 0 && mean_update < stop_mean_update;
 }
 
-void finish_report(ReconstructionReport& report, std::chrono::steady_clock::time_point start,
-                   const SparseVolume& volume) {
-  report.nonzero_voxels = volume.size();
-  report.seconds = seconds_since(start);
-  report.peak_rss_mb = peak_rss_mb();
-}
 
 }  // namespace tomorig::recon::detail

@@ -22,7 +22,7 @@ struct Support {
 // What the caller will keep per active voxel after MLOS (for the memory checks), and whether
 // it needs the voxels' image positions.
 struct SupportNeeds {
-  double mlos_threshold = 0.05;
+  double mlos_threshold = ReconstructionOptions{}.mlos_threshold;  // the one default lives there
   bool positions = true;  // a sparse system will be built (for the memory checks)
   double extra_bytes_per_voxel = 0.0;  // beyond the sparse system's own
 };
@@ -35,14 +35,10 @@ Support build_support(const ReconstructionInput& input, const ReconstructionOpti
 // The voxels of `set` whose intensity is > 0, as a sparse volume.
 SparseVolume to_volume(const VoxelGrid& grid, const std::vector<std::uint32_t>& index, const std::vector<float>& e);
 
-// Fills the totals of the report (time since `start`, peak RSS, non-zero voxels).
 // Appends the statistics of one iteration to the report; returns true when the mean update has
 // fallen below `stop_mean_update` (if > 0), i.e. when the iterations should stop.
 bool record_iteration(ReconstructionReport& report, int iteration, double residual, double mean_update,
                       double seconds, double stop_mean_update);
-
-void finish_report(ReconstructionReport& report, std::chrono::steady_clock::time_point start,
-                   const SparseVolume& volume);
 
 double seconds_since(std::chrono::steady_clock::time_point start);
 

@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "reduced_case.h"
-#include "tomorig/processing/reconstruction/ment_reference.h"
+#include "../../../processing/src/reconstruction/ment_reference.h"  // a test oracle, private to processing
 
 namespace {
 

@@ -13,6 +13,7 @@
 //   recon::ReconstructionReport report;
 //   SparseVolume v = r->reconstruct(input, report);   // v.to_dense() for a dense export
 #include <cstddef>
+#include <chrono>
 #include <functional>
 #include <memory>
 #include <string>
@@ -121,6 +122,8 @@ struct IterationView {
 };
 using IterationObserver = std::function<void(const IterationView&)>;
 
+// An algorithm implements run() only; reconstruct() owns what every algorithm shares: the
+// report's reset and common fields, the timing, and keeping the observer's time out of it.
 class Reconstructor {
  public:
   virtual ~Reconstructor() = default;
@@ -130,10 +133,23 @@ class Reconstructor {
   virtual std::string name() const = 0;
   // Throws tomorig::Error: bad_input for inconsistent, empty or non-finite input or a volume
   // too large for memory; the report is filled on success.
-  virtual SparseVolume reconstruct(const ReconstructionInput& input, ReconstructionReport& report) = 0;
+  SparseVolume reconstruct(const ReconstructionInput& input, ReconstructionReport& report);
 
  protected:
+  // The algorithm: fills the report's algorithm-specific fields (history, active voxels,
+  // set-up time, threads); the report arrives reset, with `algorithm` set.
+  virtual SparseVolume run(const ReconstructionInput& input, ReconstructionReport& report) = 0;
+  // Seconds since reconstruct() started, without the time spent in the observer.
+  double elapsed_seconds() const;
+  bool observed() const { return static_cast<bool>(observer_); }
+  // Shows the observer iteration `iteration` (0: the initial volume, `stats` null); its time
+  // is excluded from every time in the report.
+  void notify(int iteration, const IterationStats* stats, std::function<SparseVolume()> volume);
+
+ private:
   IterationObserver observer_;
+  std::chrono::steady_clock::time_point start_{};
+  double observer_seconds_ = 0.0;
 };
 
 // Throws tomorig::Error (bad_input) for an invalid option or an unknown algorithm.
