@@ -37,11 +37,15 @@ void run(const ProcessArgs& args) {
   hooks.notice = [](const std::string& text) { fmt::print(stderr, "{}\n", text); };
   hooks.started = [&](std::uint64_t sets_to_do) { progress = std::make_unique<ProgressLine>(sets_to_do); };
   hooks.set_done = [&](const pipeline::BackendSetDone& s) {
-    fmt::print(stderr, "\rset {} done: {} vectors, {:.1f} % valid, {:.1f} s\n", s.index, s.vectors,
+    const std::string by =
+        s.rank < 0 ? std::string()
+                   : fmt::format(" on rank {} (its {} sets, {:.3g} sets/s)", s.rank, s.rank_sets, s.rank_sets_per_second);
+    fmt::print(stderr, "\rset {} done{}: {} vectors, {:.1f} % valid, {:.1f} s\n", s.index, by, s.vectors,
                100.0 * s.valid_fraction, s.seconds);
     if (progress) progress->set_done();
   };
   const pipeline::BackendReport report = pipeline::run_backend(args.session, options, hooks);
+  if (report.worker_rank) return;  // an MPI rank other than 0: rank 0 reports the run
   if (report.interrupted)
     throw runtime_error(fmt::format("interrupted by {}: '{}' is valid and holds {} of {} sets; run the same command "
                                     "again to resume",
