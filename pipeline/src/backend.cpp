@@ -145,9 +145,9 @@ std::string BackendReport::brief() const {
 std::string BackendReport::ranks_brief() const {
   std::string text;
   for (const BackendRankFigures& r : ranks)
-    text += fmt::format("\nrank {} (pid {} on {}, {} threads): {} sets, {:.3g} sets/s, {:.0f} % busy", r.rank, r.pid,
+    text += fmt::format("\nrank {} (pid {} on {}, {} threads): {} sets, {:.3g} sets/s, {:.3g} s per set", r.rank, r.pid,
                         r.host, r.threads, r.sets, seconds > 0 ? r.sets / seconds : 0.0,
-                        seconds > 0 ? 100.0 * r.busy_seconds / seconds : 0.0);
+                        r.sets > 0 ? r.busy_seconds / r.sets : 0.0);
   return text;
 }
 

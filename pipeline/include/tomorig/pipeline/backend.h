@@ -65,7 +65,7 @@ struct BackendRankFigures {
   long pid = 0;
   int threads = 0;                // OpenMP threads per stage on that rank
   std::uint64_t sets = 0;         // sets it finished in this run
-  double busy_seconds = 0.0;      // the sum of its sets' times (read to result)
+  double busy_seconds = 0.0;      // the sum of its sets' times (read to result; overlapped sets both count)
 };
 
 struct BackendHooks {
@@ -101,7 +101,7 @@ struct BackendReport {
   double sets_per_second() const { return sets_processed > 0 && seconds > 0 ? sets_processed / seconds : 0.0; }
   nlohmann::json to_json() const;
   // "wrote r.h5 and r.xdmf: 4 sets (4 processed now, 0 resumed), ... ", and under MPI one more
-  // line per rank: "rank 1 (pid 4711 on node7, 2 threads): 12 sets, 0.11 sets/s, 96 % busy".
+  // line per rank: "rank 1 (pid 4711 on node7, 2 threads): 12 sets, 0.11 sets/s, 8.7 s per set".
   std::string brief() const;
   // The per-rank lines alone ("" in a single process), each starting with a newline.
   std::string ranks_brief() const;
