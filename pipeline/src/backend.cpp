@@ -220,10 +220,10 @@ void finish_results(storage::ResultsWriter& writer, const BackendOptions& option
 }
 
 BackendReport run_backend(const fs::path& session_path, const BackendOptions& options, const BackendHooks& hooks) {
+  // Under MPI the options are checked inside the ranks' agreement, so that rank 0 alone reports them.
+  if (mpi::launched_by_mpi() && (mpi::built_with_mpi() || mpi::launched_size() > 1))
+    return run_backend_on_mpi(session_path, options, hooks);
   options.validate();
-  if (mpi::launched_by_mpi()) {
-    if (mpi::built_with_mpi() || mpi::launched_size() > 1) return run_backend_on_mpi(session_path, options, hooks);
-  }
   const auto started = Clock::now();
   const auto notice = [&](const std::string& text) {
     if (hooks.notice) hooks.notice(text);

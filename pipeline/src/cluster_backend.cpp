@@ -273,6 +273,7 @@ BackendReport run_backend_on_mpi(const fs::path& session_path, const BackendOpti
   std::vector<std::uint64_t> todo;
   Failure setup_failure;
   try {
+    options.validate();
     inputs = std::make_unique<BackendInputs>(session_path, options);
     if (root) {
       writer = open_results(*inputs);

@@ -168,5 +168,27 @@ TEST_F(ProcessMpi, AJobWithAKilledRankResumesToTheSameResults) {
   expect_identical_results(reference(), out);
 }
 
+// Bad input found on every rank (a bad option) or on rank 0 alone (a results file of another
+// session): rank 0 says it once, the job exits 2 as a single process would, nothing is processed.
+TEST_F(ProcessMpi, BadInputIsReportedOnceByRankZeroWithExitCode2) {
+  std::vector<std::string> bad_dt = process_args(session_, *dir_ / "bad.h5");
+  bad_dt.insert(bad_dt.end(), {"--dt-ns", "-5"});
+  TomorigProcess dt_job(mpirun_args(3, bad_dt), kMpirun);
+  EXPECT_EQ(dt_job.wait(), 2) << dt_job.err();
+  const std::string dt_message = "error: --dt-ns -5 must be > 0";
+  const std::size_t first = dt_job.err().find(dt_message);
+  ASSERT_NE(first, std::string::npos) << dt_job.err();
+  EXPECT_EQ(dt_job.err().find(dt_message, first + 1), std::string::npos) << dt_job.err();
+  EXPECT_FALSE(fs::exists(*dir_ / "bad.h5"));
+
+  const std::string other = (*dir_ / "other.h5").string();
+  ASSERT_EQ(run_tomorig("simulate --sets 1 --ppp 0.05 --seed 8 -o " + shell_quoted(other)).exit_code, 0);
+  TomorigProcess foreign(mpirun_args(3, process_args(other, reference())), kMpirun);
+  EXPECT_EQ(foreign.wait(), 2) << foreign.err();
+  EXPECT_NE(foreign.err().find("belongs to another session"), std::string::npos) << foreign.err();
+  EXPECT_EQ(foreign.err().find(" done"), std::string::npos) << foreign.err();
+  EXPECT_EQ(storage::ResultsReader(reference()).set_indices().size(), static_cast<std::size_t>(kSets));  // untouched
+}
+
 }  // namespace
 }  // namespace tomorig::testing
