@@ -29,9 +29,10 @@ struct Header {
 static_assert(std::is_trivially_copyable_v<Header>);
 static_assert(std::is_trivially_copyable_v<Vec3f> && sizeof(Vec3f) == 12);
 
-void put(std::vector<char>& out, const void* data, std::size_t n) {
-  const char* p = static_cast<const char*>(data);
-  out.insert(out.end(), p, p + n);
+// Copies n bytes to `at` and returns the position after them (a buffer sized in advance).
+char* put(char* at, const void* data, std::size_t n) {
+  if (n > 0) std::memcpy(at, data, n);
+  return at + n;
 }
 
 }  // namespace
@@ -52,13 +53,12 @@ std::vector<char> encode_finished_set(const FinishedSet& set) {
   h.valid_fraction = set.valid_fraction;
   h.report_bytes = r.report_json.size();
   const std::size_t n = f.count();
-  std::vector<char> out;
-  out.reserve(sizeof h + n * (sizeof(Vec3f) + 1 + sizeof(float)) + r.report_json.size());
-  put(out, &h, sizeof h);
-  put(out, f.displacement.data(), n * sizeof(Vec3f));
-  put(out, f.status.data(), n * sizeof(VectorStatus));
-  put(out, f.peak.data(), n * sizeof(float));
-  put(out, r.report_json.data(), r.report_json.size());
+  std::vector<char> out(sizeof h + n * (sizeof(Vec3f) + sizeof(VectorStatus) + sizeof(float)) + r.report_json.size());
+  char* at = put(out.data(), &h, sizeof h);
+  at = put(at, f.displacement.data(), n * sizeof(Vec3f));
+  at = put(at, f.status.data(), n * sizeof(VectorStatus));
+  at = put(at, f.peak.data(), n * sizeof(float));
+  put(at, r.report_json.data(), r.report_json.size());
   return out;
 }
 
