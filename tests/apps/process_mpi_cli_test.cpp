@@ -11,6 +11,7 @@
 #include <hdf5.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -23,6 +24,7 @@
 #include "child_process.h"
 #include "cli_runner.h"
 #include "tomorig/storage/results_file.h"
+#include "tomorig/storage/session_file.h"
 
 namespace tomorig::testing {
 namespace {
@@ -198,6 +200,33 @@ TEST_F(ProcessMpi, BadInputIsReportedOnceByRankZeroWithExitCode2) {
   EXPECT_NE(foreign.err().find("belongs to another session"), std::string::npos) << foreign.err();
   EXPECT_EQ(foreign.err().find(" done"), std::string::npos) << foreign.err();
   EXPECT_EQ(storage::ResultsReader(foreign_file).set_indices().size(), 1u);  // untouched
+}
+
+// A set that cannot be processed (a frame lost in the recording) on whichever rank gets it: rank 0
+// reports that error, naming the set, and exits 2 as a single process would; the ranks stop taking
+// sets, and the file keeps every set finished before, valid for a run over the repaired session.
+TEST_F(ProcessMpi, ASetThatFailsOnAnyRankStopsTheJobWithItsError) {
+  const std::string broken = (*dir_ / "lost-frame.h5").string();
+  {  // the session of the suite with frame A of the second camera of set 5 lost
+    const storage::SessionReader from(session_);
+    storage::SessionWriter to(broken, from.info());
+    for (std::uint64_t i = 0; i < from.set_count(); ++i) {
+      FrameSet set = from.read_set(i);
+      if (i == 5) set.cameras[1].a.image = Image();
+      to.append(set);
+    }
+    to.write_truth(from.truth());
+    for (std::uint64_t i = 0; i < from.set_count(); ++i) to.write_truth_set(i, from.truth_set(i));
+    to.finish();
+  }
+  const fs::path out = *dir_ / "lost-frame-results.h5";
+  TomorigProcess job(mpirun_args(3, process_args(broken, out)), kMpirun);
+  EXPECT_EQ(job.wait(), 2) << job.err();
+  EXPECT_NE(job.err().find("set 5: frame A of camera"), std::string::npos) << job.err();
+  EXPECT_NE(job.err().find("is missing"), std::string::npos) << job.err();
+  const std::vector<std::uint64_t> kept = storage::ResultsReader(out).set_indices();  // valid
+  EXPECT_EQ(std::count(kept.begin(), kept.end(), 5u), 0);
+  EXPECT_LT(kept.size(), static_cast<std::size_t>(kSets));
 }
 
 }  // namespace
