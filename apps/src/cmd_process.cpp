@@ -44,8 +44,15 @@ void run(const ProcessArgs& args) {
                100.0 * s.valid_fraction, s.seconds);
     if (progress) progress->set_done();
   };
-  const pipeline::BackendReport report = pipeline::run_backend(args.session, options, hooks);
+  pipeline::BackendReport report;
+  try {
+    report = pipeline::run_backend(args.session, options, hooks);
+  } catch (...) {
+    if (progress && progress->mid_line()) fmt::print(stderr, "\n");  // the error on a line of its own
+    throw;
+  }
   if (report.worker_rank) return;  // an MPI rank other than 0: rank 0 reports the run
+  if (report.interrupted && progress && progress->mid_line()) fmt::print(stderr, "\n");
   if (report.interrupted)
     throw runtime_error(fmt::format("interrupted by {}: '{}' is valid and holds {} of {} sets; run the same command "
                                     "again to resume",
