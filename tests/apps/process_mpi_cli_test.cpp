@@ -4,8 +4,8 @@
 // and a per-rank summary; a job whose worker rank is killed (SIGKILL) leaves a valid file, and the
 // same command started again finishes the other sets, none twice, to the same results.
 //
-// Both runs use --threads 1: the reconstruction splits its sums over the OpenMP threads, so a
-// different thread count changes the last bits (docs/correlation.md, "Processing on a cluster").
+// Both runs use --threads 1: the back-end splits its floating-point sums over the OpenMP threads,
+// so a different thread count changes the last bits (docs/correlation.md, "Processing on a cluster").
 // Small (8 sets, a 64 x 64 x 96 voxel sub-grid, 3 x 3 x 5 vectors) so that it takes seconds.
 #include <gtest/gtest.h>
 #include <hdf5.h>
