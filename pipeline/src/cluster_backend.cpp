@@ -321,9 +321,12 @@ BackendReport run_backend_on_mpi(const fs::path& session_path, const BackendOpti
   std::optional<Failure> failed;
   try {
     failed = coordinator.run(stop_requested);
-  } catch (...) {  // MPI itself failed: the job cannot go on
-    local_worker.detach();
-    throw;
+  } catch (const std::exception& e) {
+    // MPI itself failed: the exchange cannot be finished, and the worker thread still uses what
+    // this function owns, so the whole job ends here. The file holds every set written so far.
+    notice(fmt::format("error: {}; ending the MPI job ('{}' holds {} sets; run the same command again to resume)",
+                       e.what(), options.out.string(), writer->set_count()));
+    world.abort_job(1);
   }
   local_worker.join();
   world.mark_exchange_complete();

@@ -87,6 +87,11 @@ World::~World() {
   MPI_Finalize();
 }
 
+void World::abort_job(int exit_code) const {
+  MPI_Abort(MPI_COMM_WORLD, exit_code);
+  std::abort();  // MPI_Abort does not return; this is for the compiler
+}
+
 std::string World::host() const {
   char name[MPI_MAX_PROCESSOR_NAME] = {};
   int length = 0;
@@ -156,6 +161,7 @@ World::World() {
                   "(scripts/apt-packages.txt) and build again, or run `tomorig process` without mpirun");
 }
 World::~World() = default;
+void World::abort_job(int) const { std::abort(); }
 std::string World::host() const { return {}; }
 void World::send(int, int, const std::vector<char>&) const {}
 void World::send_int64(int, int, std::int64_t) const {}

@@ -52,6 +52,8 @@ class World {
   // The ranks have gone through the whole exchange, so MPI_Finalize (collective) will not wait
   // for a rank that is gone. Without it the destructor calls MPI_Abort instead of hanging.
   void mark_exchange_complete() { complete_ = true; }
+  // Ends every rank of the job now (MPI_Abort), with `exit_code` from mpirun.
+  [[noreturn]] void abort_job(int exit_code) const;
 
   void send(int to, int tag, const std::vector<char>& bytes) const;
   void send_int64(int to, int tag, std::int64_t value) const;
