@@ -94,6 +94,10 @@ void add_process_command(CLI::App& root) {
   cmd->add_option("--png", args->png,
                   "Also write a picture (PNG) of the mean field's middle z-slice: grey = in-plane magnitude, line = "
                   "direction, black = no valid vector");
+  cmd->footer(
+      "On several processes or nodes: mpirun -n N tomorig process ... (as root add --allow-run-as-root). Rank 0 "
+      "writes the results file and hands out the sets; same file, resume and exit codes (docs/correlation.md, "
+      "\"Processing on a cluster\").");
   cmd->callback([args] { run(*args); });
 }
 
