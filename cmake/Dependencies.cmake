@@ -15,6 +15,16 @@ find_package(cppzmq REQUIRED)  # brings libzmq as its dependency
 pkg_check_modules(gpiod REQUIRED IMPORTED_TARGET libgpiod)
 pkg_check_modules(fftw3f REQUIRED IMPORTED_TARGET fftw3f)
 pkg_check_modules(aravis REQUIRED IMPORTED_TARGET aravis-0.8)
+# MPI (OpenMPI, C API) for `mpirun tomorig process`. Listed in scripts/apt-packages.txt, so it is
+# there on a machine set up by scripts/setup.sh; a build without it still works as one process and
+# refuses to run under mpirun with a message saying so.
+find_package(MPI COMPONENTS C)
+if(MPI_C_FOUND)
+  set(TOMORIG_WITH_MPI 1)
+else()
+  set(TOMORIG_WITH_MPI 0)
+  message(STATUS "MPI not found (install libopenmpi-dev): tomorig process runs as one process only")
+endif()
 if(TOMORIG_BUILD_TESTS)
   find_package(GTest REQUIRED)
 endif()

@@ -37,11 +37,22 @@ void run(const ProcessArgs& args) {
   hooks.notice = [](const std::string& text) { fmt::print(stderr, "{}\n", text); };
   hooks.started = [&](std::uint64_t sets_to_do) { progress = std::make_unique<ProgressLine>(sets_to_do); };
   hooks.set_done = [&](const pipeline::BackendSetDone& s) {
-    fmt::print(stderr, "\rset {} done: {} vectors, {:.1f} % valid, {:.1f} s\n", s.index, s.vectors,
+    const std::string by =
+        s.rank < 0 ? std::string()
+                   : fmt::format(" on rank {} (its {} sets, {:.3g} sets/s)", s.rank, s.rank_sets, s.rank_sets_per_second);
+    fmt::print(stderr, "\rset {} done{}: {} vectors, {:.1f} % valid, {:.1f} s\n", s.index, by, s.vectors,
                100.0 * s.valid_fraction, s.seconds);
     if (progress) progress->set_done();
   };
-  const pipeline::BackendReport report = pipeline::run_backend(args.session, options, hooks);
+  pipeline::BackendReport report;
+  try {
+    report = pipeline::run_backend(args.session, options, hooks);
+  } catch (...) {
+    if (progress && progress->mid_line()) fmt::print(stderr, "\n");  // the error on a line of its own
+    throw;
+  }
+  if (report.worker_rank) return;  // an MPI rank other than 0: rank 0 reports the run
+  if (report.interrupted && progress && progress->mid_line()) fmt::print(stderr, "\n");
   if (report.interrupted)
     throw runtime_error(fmt::format("interrupted by {}: '{}' is valid and holds {} of {} sets; run the same command "
                                     "again to resume",
@@ -83,6 +94,10 @@ void add_process_command(CLI::App& root) {
   cmd->add_option("--png", args->png,
                   "Also write a picture (PNG) of the mean field's middle z-slice: grey = in-plane magnitude, line = "
                   "direction, black = no valid vector");
+  cmd->footer(
+      "On several processes or nodes: mpirun -n N tomorig process ... (as root add --allow-run-as-root). Rank 0 "
+      "writes the results file and hands out the sets; same file, resume and exit codes (docs/correlation.md, "
+      "\"Processing on a cluster\").");
   cmd->callback([args] { run(*args); });
 }
 

@@ -15,6 +15,9 @@ class ProgressLine {
   double elapsed_seconds() const;
   double sets_per_second() const;
   std::uint64_t done() const { return done_; }
+  // The line is on screen without its newline (some sets done, not all): a message printed now
+  // needs one first.
+  bool mid_line() const { return done_ > 0 && done_ < total_; }
   // "[#####-----] 5/20 sets  0.12 sets/s  ETA 2m05s"
   std::string text() const;
 

@@ -9,8 +9,10 @@
 
 #include <fmt/core.h>
 
+#include "backend_parts.h"
+#include "cluster_backend.h"
 #include "memory_policy.h"
-#include "pair_processor.h"
+#include "mpi_world.h"
 #include "session_identity.h"
 #include "tomorig/core/error.h"
 #include "tomorig/pipeline/session_preprocessor.h"
@@ -104,7 +106,7 @@ void BackendOptions::validate() const {
 nlohmann::json BackendReport::to_json() const {
   const Vec3d& m = mean_displacement_voxel;
   const Vec3d& s = spatial_std_displacement_voxel;
-  return {{"out", out.string()},
+  nlohmann::json json = {{"out", out.string()},
           {"xdmf", xdmf.string()},
           {"session", session.string()},
           {"sets_in_file", sets_in_file},
@@ -117,86 +119,147 @@ nlohmann::json BackendReport::to_json() const {
           {"spatial_std_displacement_voxel", {s.x, s.y, s.z}},
           {"seconds", seconds},
           {"sets_per_second", sets_per_second()}};
+  if (!ranks.empty()) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const BackendRankFigures& r : ranks)
+      list.push_back({{"rank", r.rank},
+                      {"host", r.host},
+                      {"pid", r.pid},
+                      {"threads", r.threads},
+                      {"sets", r.sets},
+                      {"busy_seconds", r.busy_seconds},
+                      {"sets_per_second", seconds > 0 ? r.sets / seconds : 0.0}});
+    json["mpi_ranks"] = list;
+  }
+  return json;
 }
 
 std::string BackendReport::brief() const {
   return fmt::format("wrote {} and {}: {} sets ({} processed now, {} resumed), {} x {} x {} vectors, {:.1f} % valid, "
                      "mean speed {:.4g} m/s, {:.1f} s ({:.3g} sets/s)",
                      out.string(), xdmf.string(), sets_in_file, sets_processed, sets_resumed, nodes[0], nodes[1],
-                     nodes[2], 100.0 * mean_valid_fraction, mean_speed_m_s, seconds, sets_per_second());
+                     nodes[2], 100.0 * mean_valid_fraction, mean_speed_m_s, seconds, sets_per_second()) +
+         ranks_brief();
 }
 
-BackendReport run_backend(const fs::path& session_path, const BackendOptions& options, const BackendHooks& hooks) {
-  const auto started = Clock::now();
-  options.validate();
-  const auto notice = [&](const std::string& text) {
-    if (hooks.notice) hooks.notice(text);
-  };
-  const auto stop_requested = [&] { return hooks.should_stop && hooks.should_stop(); };
+std::string BackendReport::ranks_brief() const {
+  std::string text;
+  for (const BackendRankFigures& r : ranks)
+    text += fmt::format("\nrank {} (pid {} on {}, {} threads): {} sets, {:.3g} sets/s, {:.3g} s per set", r.rank, r.pid,
+                        r.host, r.threads, r.sets, seconds > 0 ? r.sets / seconds : 0.0,
+                        r.sets > 0 ? r.busy_seconds / r.sets : 0.0);
+  return text;
+}
 
-  const storage::SessionReader session(session_path);
-  if (session.set_count() == 0)
-    throw bad_input(fmt::format("session '{}' holds no set to process", session_path.string()));
-  const PairProcessor processor(describe_session(session), options);  // the rig config parsed once
-  const recon::ReconstructionInput& input = processor.input();
+BackendInputs::BackendInputs(const fs::path& session_path, const BackendOptions& opts)
+    : path(session_path),
+      options(opts),
+      session(session_path),
+      processor(describe_session(session), options),
+      sets_asked(options.max_sets > 0 ? std::min<std::uint64_t>(options.max_sets, session.set_count())
+                                      : session.set_count()),
+      dt(pulse_separations(session, session_path, options, sets_asked)) {}
 
-  BackendReport report;
-  report.out = options.out;
-  report.xdmf = storage::ResultsWriter::sidecar_path(options.out);
-  report.session = session_path;
-  report.sets_asked =
-      options.max_sets > 0 ? std::min<std::uint64_t>(options.max_sets, session.set_count()) : session.set_count();
-  const std::vector<std::int64_t> dt = pulse_separations(session, session_path, options, report.sets_asked);
+void BackendInputs::prepare_preprocessing() {
+  if (!preprocessor_) preprocessor_.emplace(session, options.preprocess_chain);
+}
 
-  const std::string identity = session_identity(session);
-  nlohmann::json parameters = processor.parameters();
+ReconstructedSet BackendInputs::reconstruct(std::uint64_t index) {
+  prepare_preprocessing();
+  const auto set_started = Clock::now();
+  FrameSet set = session.read_set(index);
+  preprocessor_->apply(set);
+  ReconstructedSet pair = processor.reconstruct(set, index, dt[index]);
+  pair.started = set_started;  // a set's time includes reading and preprocessing it
+  return pair;
+}
+
+std::unique_ptr<storage::ResultsWriter> open_results(const BackendInputs& inputs) {
+  const BackendOptions& options = inputs.options;
+  const std::string identity = session_identity(inputs.session);
+  nlohmann::json parameters = inputs.processor.parameters();
   parameters["preprocess"] = {{"chain_file", options.preprocess_chain.string()},
                               {"chain_toml", file_text(options.preprocess_chain)}};
   parameters["dt_override_ns"] = options.dt_ns;
   std::error_code ec;
   if (!options.overwrite && fs::exists(options.out, ec)) check_existing_results(options.out, identity, parameters["grid"]);
-  storage::ResultsWriter writer(options.out,
-                                {.session_path = session_path.string(),
-                                 .session_identity = identity,
-                                 .parameters_json = parameters.dump(),
-                                 .voxel_size_mm = input.grid.voxel_size},
-                                {.overwrite = options.overwrite});
-  if (writer.resumed_sets() == 0) writer.write();  // an empty, valid file from the start: the path works
-  report.sets_resumed = writer.resumed_sets();
+  auto writer = std::make_unique<storage::ResultsWriter>(
+      options.out,
+      storage::ResultsInfo{.session_path = inputs.path.string(),
+                           .session_identity = identity,
+                           .parameters_json = parameters.dump(),
+                           .voxel_size_mm = inputs.processor.input().grid.voxel_size},
+      storage::ResultsWriterOptions{.overwrite = options.overwrite});
+  if (writer->resumed_sets() == 0) writer->write();  // an empty, valid file from the start: the path works
+  return writer;
+}
 
+std::vector<std::uint64_t> sets_to_do(const storage::ResultsWriter& writer, std::uint64_t sets_asked) {
   std::vector<std::uint64_t> todo;
-  for (std::uint64_t s = 0; s < report.sets_asked; ++s)
+  for (std::uint64_t s = 0; s < sets_asked; ++s)
     if (!writer.has_set(s)) todo.push_back(s);
-  if (writer.resumed_sets() > 0)
-    notice(fmt::format("resuming {}: {} sets already finished, {} to do", options.out.string(), writer.resumed_sets(),
+  return todo;
+}
+
+BackendReport start_report(const BackendInputs& inputs, const storage::ResultsWriter& writer) {
+  BackendReport report;
+  report.out = inputs.options.out;
+  report.xdmf = storage::ResultsWriter::sidecar_path(inputs.options.out);
+  report.session = inputs.path;
+  report.sets_asked = inputs.sets_asked;
+  report.sets_resumed = writer.resumed_sets();
+  return report;
+}
+
+void finish_results(storage::ResultsWriter& writer, const BackendOptions& options, BackendReport& report) {
+  writer.close();  // errors surface here rather than in the destructor
+  report.sets_in_file = writer.set_count();
+  const storage::EnsembleStatistics stats = writer.statistics();
+  summarise(stats, report);
+  if (!options.png.empty()) draw_mean_slice(stats, options.png);
+}
+
+BackendReport run_backend(const fs::path& session_path, const BackendOptions& options, const BackendHooks& hooks) {
+  // Under MPI the options are checked inside the ranks' agreement, so that rank 0 alone reports them.
+  if (mpi::launched_by_mpi() && (mpi::built_with_mpi() || mpi::launched_size() > 1))
+    return run_backend_on_mpi(session_path, options, hooks);
+  options.validate();
+  const auto started = Clock::now();
+  const auto notice = [&](const std::string& text) {
+    if (hooks.notice) hooks.notice(text);
+  };
+  const auto stop_requested = [&] { return hooks.should_stop && hooks.should_stop(); };
+
+  BackendInputs inputs(session_path, options);
+  const recon::ReconstructionInput& input = inputs.processor.input();
+  const std::unique_ptr<storage::ResultsWriter> writer = open_results(inputs);
+  storage::ResultsWriter& results = *writer;
+  BackendReport report = start_report(inputs, results);
+  const std::vector<std::uint64_t> todo = sets_to_do(results, report.sets_asked);
+  if (results.resumed_sets() > 0)
+    notice(fmt::format("resuming {}: {} sets already finished, {} to do", options.out.string(), results.resumed_sets(),
                        todo.size()));
 
-  SessionPreprocessor preprocessor(session, options.preprocess_chain);
+  inputs.prepare_preprocessing();
   report.overlapped = !options.sequential && overlap_fits(input.grid, available_memory_bytes());
   notice(fmt::format("processing {} sets of {} with {} on a {} x {} x {} grid ({}), {} cameras, {}", todo.size(),
-                     session_path.string(), processor.reconstruction().algorithm, input.grid.nx, input.grid.ny,
-                     input.grid.nz, processor.cameras().source, input.cameras.size(),
+                     session_path.string(), inputs.processor.reconstruction().algorithm, input.grid.nx, input.grid.ny,
+                     input.grid.nz, inputs.processor.cameras().source, input.cameras.size(),
                      report.overlapped ? "reconstruction and correlation overlapped" : "one set at a time"));
   if (hooks.started) hooks.started(todo.size());
 
   std::size_t next = 0;
   const auto produce = [&](const std::function<bool()>& stop) -> std::optional<ReconstructedSet> {
     if (next >= todo.size() || stop() || stop_requested()) return std::nullopt;
-    const auto set_started = Clock::now();
-    const std::uint64_t index = todo[next++];
-    FrameSet set = session.read_set(index);
-    preprocessor.apply(set);
-    ReconstructedSet pair = processor.reconstruct(set, index, dt[index]);
-    pair.started = set_started;  // a set's time includes reading and preprocessing it
-    return pair;
+    return inputs.reconstruct(todo[next++]);
   };
 
   double valid_sum = 0.0;
   const auto consume = [&](ReconstructedSet& r) -> bool {
     if (stop_requested()) return false;
     piv::CorrelationReport corr_report;
-    const storage::SetResult result = processor.correlate(r, corr_report);
-    writer.add(result);
+    const storage::SetResult result = inputs.processor.correlate(r, corr_report);
+    results.add(result);
     valid_sum += corr_report.valid_fraction();
     ++report.sets_processed;
     if (hooks.set_done)
@@ -216,17 +279,15 @@ BackendReport run_backend(const fs::path& session_path, const BackendOptions& op
       if (!consume(*r)) break;
   }
 
-  report.sets_in_file = writer.set_count();
+  report.sets_in_file = results.set_count();
   report.mean_valid_fraction = report.sets_processed > 0 ? valid_sum / report.sets_processed : 0.0;
-  report.seconds = std::chrono::duration<double>(Clock::now() - started).count();
   if (stop_requested()) {
     report.interrupted = true;  // the file is valid: every finished set is in it
+    report.seconds = std::chrono::duration<double>(Clock::now() - started).count();
     return report;
   }
-  writer.close();  // errors surface here rather than in the destructor
-  const storage::EnsembleStatistics stats = writer.statistics();
-  summarise(stats, report);
-  if (!options.png.empty()) draw_mean_slice(stats, options.png);
+  finish_results(results, options, report);
+  report.seconds = std::chrono::duration<double>(Clock::now() - started).count();
   return report;
 }
 

@@ -22,11 +22,12 @@ namespace tomorig::testing {
 
 class TomorigProcess {
  public:
-  explicit TomorigProcess(const std::vector<std::string>& args) {
+  // `program` is tomorig itself unless a test runs it through a launcher (mpirun).
+  explicit TomorigProcess(const std::vector<std::string>& args, const std::string& program = TOMORIG_BINARY) {
     int fds[2];
     if (pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe2 failed");
     const std::string out_path = (out_dir_ / "stdout.txt").string();
-    std::vector<std::string> argv_text{TOMORIG_BINARY};
+    std::vector<std::string> argv_text{program};
     argv_text.insert(argv_text.end(), args.begin(), args.end());
     std::vector<char*> argv;
     for (auto& a : argv_text) argv.push_back(a.data());

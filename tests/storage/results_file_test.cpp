@@ -486,3 +486,79 @@ TEST(ResultsFile, ReadsAndResumesVersion1AndRefusesNewerVersions) {
 
 }  // namespace
 }  // namespace tomorig::testing
+
+namespace tomorig::testing {
+namespace {
+
+// A set whose displacement differs from node to node and set to set in its last bits, so that the
+// order in which sets enter Welford's update shows in the statistics' last bits.
+SetResult uneven_set(std::uint64_t index) {
+  SetResult r = set_with(index, 0.0f);
+  for (std::size_t n = 0; n < r.field.count(); ++n) {
+    const float u = 0.1f * static_cast<float>(index + 1) + 0.013f * static_cast<float>(n * n % 7) + 1e-3f / (index + 3);
+    r.field.displacement[n] = {u, u * u - 0.3f, 1.0f / (u + 1.7f)};
+  }
+  return r;
+}
+
+std::vector<double> stored_doubles(const std::filesystem::path& path, const char* dataset) {
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  EXPECT_GE(file, 0);
+  const hid_t d = H5Dopen2(file, dataset, H5P_DEFAULT);
+  EXPECT_GE(d, 0);
+  const hid_t space = H5Dget_space(d);
+  std::vector<double> values(static_cast<std::size_t>(H5Sget_simple_extent_npoints(space)));
+  EXPECT_GE(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), 0);
+  H5Sclose(space);
+  H5Dclose(d);
+  H5Fclose(file);
+  return values;
+}
+
+bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+// Sets from several MPI ranks (or a resumed file's gaps) arrive out of index order; the file's
+// /statistics must still be those of one run adding them in order, bit for bit.
+TEST(ResultsFile, StatisticsOfSetsAddedOutOfOrderAreThoseOfTheSetOrder) {
+  const std::vector<std::uint64_t> arrival{4, 1, 6, 0, 3, 5, 2};
+  storage::EnsembleAccumulator in_order(kVoxelMm), as_arrived(kVoxelMm);
+  for (std::uint64_t i = 0; i < arrival.size(); ++i) in_order.add(uneven_set(i));
+  for (const std::uint64_t i : arrival) as_arrived.add(uneven_set(i));
+  const auto flat = [](const std::vector<Vec3d>& v) {
+    std::vector<double> out;
+    for (const Vec3d& x : v) out.insert(out.end(), {x.x, x.y, x.z});
+    return out;
+  };
+  // The premise: the arrival order alone changes the last bits of the running statistics.
+  ASSERT_FALSE(same_bits(flat(in_order.result().rms_velocity), flat(as_arrived.result().rms_velocity)) &&
+               same_bits(flat(in_order.result().mean_velocity), flat(as_arrived.result().mean_velocity)));
+
+  TempDir dir;
+  const auto path = dir / "r.h5";
+  {
+    ResultsWriter w(path, info());
+    w.add(uneven_set(arrival[0]));
+    w.add(uneven_set(arrival[1]));
+    w.add(uneven_set(arrival[2]));
+  }
+  {  // resumed, the rest still out of order
+    ResultsWriter w(path, info());
+    for (std::size_t k = 3; k < arrival.size(); ++k) w.add(uneven_set(arrival[k]));
+    w.close();
+    EXPECT_TRUE(same_bits(flat(w.statistics().mean_velocity), flat(in_order.result().mean_velocity)));
+  }
+  const storage::EnsembleStatistics expected = in_order.result();
+  EXPECT_TRUE(same_bits(stored_doubles(path, "/statistics/mean_velocity_m_s"), flat(expected.mean_velocity)));
+  EXPECT_TRUE(same_bits(stored_doubles(path, "/statistics/rms_velocity_m_s"), flat(expected.rms_velocity)));
+  EXPECT_TRUE(same_bits(stored_doubles(path, "/statistics/mean_displacement_voxel"),
+                        flat(expected.mean_displacement_voxel)));
+  std::vector<double> reynolds;
+  for (const auto& r : expected.reynolds_stress) reynolds.insert(reynolds.end(), r.begin(), r.end());
+  EXPECT_TRUE(same_bits(stored_doubles(path, "/statistics/reynolds_stress_m2_s2"), reynolds));
+  EXPECT_EQ(stored_doubles(path, "/statistics/sets"), std::vector<double>{7.0});
+}
+
+}  // namespace
+}  // namespace tomorig::testing

@@ -37,9 +37,12 @@ const PlanPair& plans_for(Int3 w) {
     std::unique_ptr<float, FftwFree> r(fftwf_alloc_real(real));
     std::unique_ptr<float, FftwFree> c(reinterpret_cast<float*>(fftwf_alloc_complex(complex)));
     auto* cc = reinterpret_cast<fftwf_complex*>(c.get());
-    // FFTW takes dimensions slowest first: z, y, x.
-    it->second.forward = fftwf_plan_dft_r2c_3d(w.z, w.y, w.x, r.get(), cc, FFTW_MEASURE);
-    it->second.backward = fftwf_plan_dft_c2r_3d(w.z, w.y, w.x, cc, r.get(), FFTW_MEASURE);
+    // FFTW takes dimensions slowest first: z, y, x. FFTW_ESTIMATE, not FFTW_MEASURE: a measured
+    // plan is chosen by timing, so two processes (MPI ranks, a resumed run, a busy machine) could
+    // pick different algorithms and round differently; an estimated plan is the same everywhere,
+    // so a set's vectors are bit-identical whichever process correlates it.
+    it->second.forward = fftwf_plan_dft_r2c_3d(w.z, w.y, w.x, r.get(), cc, FFTW_ESTIMATE);
+    it->second.backward = fftwf_plan_dft_c2r_3d(w.z, w.y, w.x, cc, r.get(), FFTW_ESTIMATE);
     if (!it->second.forward || !it->second.backward) {
       cache.erase(it);
       throw runtime_error("correlation: FFTW could not plan a window of " + std::to_string(w.x) + " x " +

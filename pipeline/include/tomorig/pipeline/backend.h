@@ -51,6 +51,21 @@ struct BackendSetDone {
   std::size_t vectors = 0;
   double valid_fraction = 0.0;
   double seconds = 0.0;  // from reading the set to its result written
+  // Under MPI: the rank that did the set, how many it has done and its sets/s since the start;
+  // rank -1 in a single process.
+  int rank = -1;
+  std::uint64_t rank_sets = 0;
+  double rank_sets_per_second = 0.0;
+};
+
+// One MPI rank's share of a run (BackendReport::ranks).
+struct BackendRankFigures {
+  int rank = 0;
+  std::string host;
+  long pid = 0;
+  int threads = 0;                // OpenMP threads per stage on that rank
+  std::uint64_t sets = 0;         // sets it finished in this run
+  double busy_seconds = 0.0;      // the sum of its sets' times (read to result; overlapped sets both count)
 };
 
 struct BackendHooks {
@@ -77,16 +92,29 @@ struct BackendReport {
   Vec3d mean_displacement_voxel;     // spatial mean of the ensemble mean displacement
   Vec3d spatial_std_displacement_voxel;
   double seconds = 0.0;
+  // Under MPI (on rank 0; a single process leaves them empty): every rank's share.
+  std::vector<BackendRankFigures> ranks;
+  // Under MPI on a rank other than 0: this rank only worked for rank 0, which reports the run;
+  // nothing else in the report is filled in.
+  bool worker_rank = false;
 
   double sets_per_second() const { return sets_processed > 0 && seconds > 0 ? sets_processed / seconds : 0.0; }
   nlohmann::json to_json() const;
-  // "wrote r.h5 and r.xdmf: 4 sets (4 processed now, 0 resumed), ... "
+  // "wrote r.h5 and r.xdmf: 4 sets (4 processed now, 0 resumed), ... ", and under MPI one more
+  // line per rank: "rank 1 (pid 4711 on node7, 2 threads): 12 sets, 0.11 sets/s, 8.7 s per set".
   std::string brief() const;
+  // The per-rank lines alone ("" in a single process), each starting with a newline.
+  std::string ranks_brief() const;
 };
 
 // Throws tomorig::Error: bad_input for a bad option, session, calibration or a set that cannot
 // be processed (a missing frame, no pulse separation), naming what to change; runtime for a
 // failure of the results file.
+//
+// Started by mpirun (or srun), the run is one of an MPI job's ranks (cluster_backend.cpp): rank
+// 0 owns the results file and hands out the sets one at a time to whichever rank asks next,
+// itself included; the hooks are called on rank 0 only, and the other ranks return a report with
+// worker_rank set. Without a launcher MPI is never initialised.
 BackendReport run_backend(const std::filesystem::path& session, const BackendOptions& options,
                           const BackendHooks& hooks = {});
 

@@ -122,6 +122,9 @@ class ResultsWriter {
   // Creates the file now if it does not exist yet (an empty, valid results file).
   void write();
   // Flushes, writes the sidecar and closes the file (the destructor does the same, silently).
+  // If a set was added after one of a higher index (resumed gaps, sets from several MPI ranks),
+  // the statistics are first recomputed reading the sets in index order (O(file) once), so they
+  // are bit-identical to those of one uninterrupted run over the same sets.
   void close();
 
   const std::filesystem::path& path() const;
