@@ -290,8 +290,10 @@ void SessionWriter::Impl::create_quicklook_datasets() {
     o.chunk.insert(o.chunk.end(), record_shape.begin(), record_shape.end());
     h5::GrowingDataset d(group.get(), name, layout::quicklook_path(name), o);
     if (columns != nullptr) {
+      // Fixed-length, like every string of a format-2 session: a damaged variable-length
+      // string's heap index can crash libhdf5 1.10 (docs/reliability.md).
       h5::Dataset opened = h5::open_dataset(group.get(), name, layout::quicklook_path(name));
-      h5::write_string_list_attr(opened.get(), layout::kAttrColumns,
+      h5::write_fixed_string_list_attr(opened.get(), layout::kAttrColumns,
                                  std::vector<std::string>(columns->begin(), columns->end()),
                                  layout::quicklook_path(name));
     }
