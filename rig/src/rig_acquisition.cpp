@@ -11,6 +11,7 @@
 
 #include "tomorig/rig/simulate_session.h"
 #include "tomorig/acquisition/aravis_camera.h"
+#include "tomorig/acquisition/gentl_camera.h"
 #include "tomorig/core/error.h"
 #include "tomorig/simulators/simulated_rig.h"
 #include "tomorig/trigger/rig_trigger.h"
@@ -34,7 +35,7 @@ acquisition::AssemblerOptions::CameraPairing pairing_of(const config::CameraConf
     pairing.free_running = true;
     return pairing;
   }
-  if (cam.backend != config::CameraBackend::aravis) return pairing;
+  if (cam.backend == config::CameraBackend::simulated) return pairing;
   pairing.expected_separation_ns = plan.frame_separation_ns();
   if (timing.frame_time_tolerance_us) {
     pairing.tolerance_ns = std::llround(*timing.frame_time_tolerance_us * 1000.0);
@@ -79,7 +80,7 @@ RigAcquisition::RigAcquisition(const config::RigConfig& rig, RigAcquisitionOptio
   std::size_t simulated = 0;
   for (const auto& cam : rig_.cameras) simulated += cam.backend == config::CameraBackend::simulated ? 1 : 0;
   if (simulated != 0 && simulated != rig_.cameras.size())
-    throw bad_input("the rig mixes simulated and aravis cameras; use one backend for every camera");
+    throw bad_input("the rig mixes simulated and real (aravis, gentl) cameras; use simulated cameras for all or none");
   for (const auto& [id, fault] : options_.faults) {
     bool known = false;
     for (const auto& cam : rig_.cameras) known |= cam.id == id && cam.backend == config::CameraBackend::simulated;
@@ -147,7 +148,9 @@ RigAcquisition::RigAcquisition(const config::RigConfig& rig, RigAcquisitionOptio
                                          : plan_.period_ns;
         aravis.match_tolerance_ns = closest / 2;
       }
-      auto camera = std::make_unique<acquisition::AravisCamera>(cam.id, aravis);
+      // GenTL cameras (frame grabbers) are Aravis-engine cameras reached through a producer.
+      auto camera = cam.backend == config::CameraBackend::gentl ? acquisition::make_gentl_camera(cam.id, aravis)
+                                                                : std::make_unique<acquisition::AravisCamera>(cam.id, aravis);
       camera->configure(cam);  // an absent camera or a refused feature is named here
       session_cameras_.push_back({cam.id, cam.roi.width, cam.roi.height, cam.pixel_format, cam.pixel_pitch_um});
       aravis_cameras_.push_back(camera.get());
