@@ -247,7 +247,7 @@ TEST(GenTLCamera, PayloadComesFromTheStreamWhenTheCameraHasNoPayloadSize) {
   unsetenv("MOCK_GENTL_NO_PAYLOADSIZE");
 }
 
-// Without GenTL 1.3+ functions the producer still serves.
+// An older producer: without GenTL 1.3+ functions, stamping in ticks, wanting aligned buffers.
 TEST(GenTLCamera, AProducerWithoutOptionalFunctionsStreams) {
   auto cam = make_gentl_camera("cam0", software_burst());
   ASSERT_NO_THROW(cam->configure(gentl_config("cam0", "mockcam0", TOMORIG_MOCK_GENTL_V12)));
@@ -256,7 +256,11 @@ TEST(GenTLCamera, AProducerWithoutOptionalFunctionsStreams) {
   for (int t = 0; t < 4; ++t) cam->software_trigger();
   ASSERT_TRUE(frames.wait_for(8));
   cam->stop();
-  expect_burst_pairs(frames.take(), 0);
+  const auto got = frames.take();
+  expect_burst_pairs(got, 0);
+  // This producer stamps in microsecond ticks (TIMESTAMP, TIMESTAMP_FREQUENCY = 1 MHz): frame B
+  // follows A by the 250 us exposure, converted to nanoseconds.
+  for (std::size_t i = 0; i + 1 < got.size(); i += 2) EXPECT_EQ(got[i + 1].timestamp_ns - got[i].timestamp_ns, 250'000);
 }
 
 // Hardware-style triggers: TriggerSource = Line1, pulses from the grabber's I/O line (the

@@ -72,6 +72,7 @@ enum : std::int32_t {
   kDevInfoDisplayName = 4,
   kDevInfoUserDefinedName = 6,
   kDevInfoSerialNumber = 7,
+  kDevInfoTimestampFrequency = 9,
 };
 // STREAM_INFO_CMD.
 enum : std::int32_t {
@@ -81,6 +82,7 @@ enum : std::int32_t {
   kStreamInfoPayloadSize = 7,
   kStreamInfoDefinesPayloadSize = 9,
   kStreamInfoBufAnnounceMin = 12,
+  kStreamInfoBufAlignment = 13,
 };
 // BUFFER_INFO_CMD.
 enum : std::int32_t {

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstddef>
+#include <new>
 #include <thread>
 
 #include "tomorig/core/error.h"
@@ -86,10 +88,25 @@ std::shared_ptr<GenTLFrameStream> GenTLFrameStream::create(std::shared_ptr<DataS
   // The producer may need more buffers than asked to stream at all.
   std::size_t minimum = 0;
   if (stream_info(*self->stream_, gentl::kStreamInfoBufAnnounceMin, minimum)) count = std::max<int>(count, static_cast<int>(minimum));
+  // Grabbers that DMA into the buffers may need them aligned (a page, often).
+  std::size_t alignment = alignof(std::max_align_t);
+  if (std::size_t wanted = 0; stream_info(*self->stream_, gentl::kStreamInfoBufAlignment, wanted) && wanted > alignment &&
+                              (wanted & (wanted - 1)) == 0)
+    alignment = wanted;
+  // Timestamps in ticks (producers before GenTL 1.5) are converted with the device's frequency.
+  {
+    gentl::InfoType type = gentl::kTypeUnknown;
+    std::size_t size = sizeof self->tick_hz_;
+    if (f.DevGetInfo(self->stream_->device().handle(), gentl::kDevInfoTimestampFrequency, &type, &self->tick_hz_,
+                     &size) != gentl::kSuccess ||
+        size != sizeof self->tick_hz_)
+      self->tick_hz_ = 0;
+  }
   for (int i = 0; i < count; ++i) {
-    // Default-initialised: the producer overwrites the image before a buffer is delivered
-    // complete, and incomplete buffers are never delivered.
-    self->memory_.push_back(std::make_unique_for_overwrite<std::byte[]>(payload));
+    // Uninitialised: the producer overwrites the image before a buffer is delivered complete,
+    // and incomplete buffers are never delivered.
+    self->memory_.emplace_back(static_cast<std::byte*>(::operator new[](payload, std::align_val_t(alignment))),
+                               AlignedDelete{alignment});
     gentl::Handle buffer = nullptr;
     const gentl::Status status = f.DSAnnounceBuffer(ds, self->memory_.back().get(), payload,
                                                     reinterpret_cast<void*>(static_cast<std::uintptr_t>(i)), &buffer);
@@ -175,11 +192,15 @@ std::optional<detail::StreamBuffer> GenTLFrameStream::pop(std::chrono::microseco
     out.data = static_cast<const std::byte*>(base) + offset;
     out.size = filled - offset;
   }
-  // Nanoseconds (GenTL 1.5); else the producer's tick counter, taken for nanoseconds (the
-  // trigger matcher needs only the rate); else when the event arrived.
+  // Nanoseconds (GenTL 1.5); else the producer's ticks at the device's timestamp frequency
+  // (taken for nanoseconds when it does not say); else when the event arrived.
   std::uint64_t stamp = 0;
-  if (buffer_info(buffer, gentl::kBufInfoTimestampNs, stamp) || buffer_info(buffer, gentl::kBufInfoTimestamp, stamp))
+  if (buffer_info(buffer, gentl::kBufInfoTimestampNs, stamp))
     out.timestamp_ns = static_cast<std::int64_t>(stamp);
+  else if (buffer_info(buffer, gentl::kBufInfoTimestamp, stamp))
+    out.timestamp_ns = tick_hz_ > 0 && tick_hz_ != 1'000'000'000
+                           ? static_cast<std::int64_t>(static_cast<long double>(stamp) * 1e9L / tick_hz_)
+                           : static_cast<std::int64_t>(stamp);
   else
     out.timestamp_ns = steady_ns();
   return out;

@@ -56,7 +56,12 @@ class GenTLFrameStream final : public detail::FrameStream, public std::enable_sh
 
   std::shared_ptr<DataStream> stream_;
   std::string what_;
-  std::vector<std::unique_ptr<std::byte[]>> memory_;
+  struct AlignedDelete {
+    std::size_t alignment;
+    void operator()(std::byte* memory) const { ::operator delete[](memory, std::align_val_t(alignment)); }
+  };
+  std::vector<std::unique_ptr<std::byte[], AlignedDelete>> memory_;
+  std::uint64_t tick_hz_ = 0;  // the device's timestamp frequency; 0: unknown
   std::vector<gentl::Handle> buffers_;
   gentl::Handle event_ = nullptr;
   std::atomic<bool> started_{false};

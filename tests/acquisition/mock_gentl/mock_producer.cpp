@@ -16,7 +16,9 @@
 //   MOCK_GENTL_FAIL_INIT=1      GCInitLib fails
 //   MOCK_GENTL_XML=zip|file     the description is served zipped, or as a file: URL
 //   MOCK_GENTL_NO_PAYLOADSIZE=1 the description has no PayloadSize (the stream gives it)
-// Build variants: MOCK_GENTL_NO_OPTIONAL leaves out the GenTL 1.3+ functions;
+// Build variants: MOCK_GENTL_NO_OPTIONAL is an older producer: no GenTL 1.3+ functions,
+// timestamps in microsecond ticks (TIMESTAMP and the device's TIMESTAMP_FREQUENCY, no
+// TIMESTAMP_NS), and buffers that must be 4096-byte aligned (BUF_ALIGNMENT);
 // MOCK_GENTL_OMIT_QUEUE leaves out the mandatory DSQueueBuffer.
 //
 // Written for tests only: one process, a handful of cameras, no real hardware.
@@ -768,6 +770,9 @@ Status device_info(Device& d, std::int32_t cmd, InfoType* type, void* buffer, st
     case kDevInfoDisplayName: return put_string(type, buffer, size, "tomorig MockGenTL " + d.id);
     case kDevInfoSerialNumber: return put_string(type, buffer, size, "MOCK000" + std::to_string(d.index));
     case kDevInfoUserDefinedName: return put_string(type, buffer, size, "");
+#ifdef MOCK_GENTL_NO_OPTIONAL
+    case kDevInfoTimestampFrequency: return put<std::uint64_t>(type, buffer, size, 1'000'000, kTypeUInt64);
+#endif
     default: return fail(kErrNotImplemented, "device info not available");
   }
 }
@@ -839,6 +844,9 @@ MOCK_EXPORT Status DSAnnounceBuffer(Handle stream, void* memory, std::size_t siz
   auto* s = as<Stream>(stream, kMagicStream);
   if (s == nullptr) return fail(kErrInvalidHandle, "not a stream");
   if (memory == nullptr || size == 0) return fail(kErrInvalidParameter, "no memory");
+#ifdef MOCK_GENTL_NO_OPTIONAL
+  if (reinterpret_cast<std::uintptr_t>(memory) % 4096 != 0) return fail(kErrInvalidParameter, "buffer not 4096-byte aligned");
+#endif
   std::lock_guard lock(s->mutex);
   auto b = std::make_unique<Buffer>();
   b->base = static_cast<std::byte*>(memory);
@@ -901,6 +909,9 @@ MOCK_EXPORT Status DSGetInfo(Handle stream, std::int32_t cmd, InfoType* type, vo
     case kStreamInfoPayloadSize: return put<std::size_t>(type, buffer, size, payload, kTypeSizeT);
     case kStreamInfoDefinesPayloadSize: return put<Bool8>(type, buffer, size, 0, kTypeBool8);
     case kStreamInfoBufAnnounceMin: return put<std::size_t>(type, buffer, size, 2, kTypeSizeT);
+#ifdef MOCK_GENTL_NO_OPTIONAL
+    case kStreamInfoBufAlignment: return put<std::size_t>(type, buffer, size, 4096, kTypeSizeT);
+#endif
     default: return fail(kErrNotImplemented, "stream info not available");
   }
 }
@@ -961,7 +972,12 @@ MOCK_EXPORT Status DSGetBufferInfo(Handle stream, Handle buffer, std::int32_t cm
   switch (cmd) {
     case kBufInfoBase: return put<void*>(type, out, size, b->base, kTypePtr);
     case kBufInfoSize: return put<std::size_t>(type, out, size, b->size, kTypeSizeT);
+#ifdef MOCK_GENTL_NO_OPTIONAL
+    case kBufInfoTimestamp: return put<std::uint64_t>(type, out, size, b->timestamp_ns / 1000, kTypeUInt64);
+#else
     case kBufInfoTimestamp: return put<std::uint64_t>(type, out, size, b->timestamp_ns, kTypeUInt64);
+    case kBufInfoTimestampNs: return put<std::uint64_t>(type, out, size, b->timestamp_ns, kTypeUInt64);
+#endif
     case kBufInfoIsIncomplete: return put<Bool8>(type, out, size, b->incomplete ? 1 : 0, kTypeBool8);
     case kBufInfoSizeFilled: return put<std::size_t>(type, out, size, b->filled, kTypeSizeT);
     case kBufInfoWidth: return put<std::size_t>(type, out, size, b->width, kTypeSizeT);
@@ -971,7 +987,6 @@ MOCK_EXPORT Status DSGetBufferInfo(Handle stream, Handle buffer, std::int32_t cm
     case kBufInfoImageOffset: return put<std::size_t>(type, out, size, 0, kTypeSizeT);
     case kBufInfoPixelFormat: return put<std::uint64_t>(type, out, size, b->pixel_format, kTypeUInt64);
     case kBufInfoPixelFormatNamespace: return put<std::uint64_t>(type, out, size, kPixelNamespacePfnc32, kTypeUInt64);
-    case kBufInfoTimestampNs: return put<std::uint64_t>(type, out, size, b->timestamp_ns, kTypeUInt64);
     default: return fail(kErrNotImplemented, "buffer info not available");
   }
 }
