@@ -318,7 +318,11 @@ void AravisCamera::Impl::deliver(const detail::StreamBuffer& buffer, FrameIdUnwr
   frame.timestamp_ns = buffer.timestamp_ns;
   if (matcher) {
     // The camera numbers frames, not events: the trigger it answers is found by time.
-    const auto hit = matcher->match(*sequence, frame.timestamp_ns);
+    // Double-frame bursts alternate A, B in the frame counter: that says which frame this is
+    // when its partner was lost; the matcher finds the trigger by time.
+    const std::optional<Exposure> burst_position =
+        options.frame_mode == config::FrameMode::hardware ? std::optional(frame.exposure) : std::nullopt;
+    const auto hit = matcher->match(*sequence, frame.timestamp_ns, burst_position);
     if (!hit || !hit->event) {  // a warm-up frame, or one no trigger explains
       if (!hit) ++unmatched;
       pool->give_back(buffer.token);

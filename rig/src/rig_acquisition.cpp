@@ -24,6 +24,10 @@ using Clock = std::chrono::steady_clock;
 
 // How often the loop looks up from waiting for an event to check for a stop or the duration.
 constexpr std::chrono::milliseconds kEventPoll{50};
+// Camera buffer pools: besides the set timeout, the time a set may wait to be taken from the
+// assembler and written, and a few buffers in flight in the stream itself.
+constexpr std::chrono::duration<double> kQueueAllowance{0.5};
+constexpr int kSpareBuffers = 8;
 
 // How the assembler checks a camera's pairs: B - A of its timestamps against the plan's frame
 // separation (Aravis cameras; a simulated camera stamps frames with the trigger's own times).
@@ -139,6 +143,12 @@ RigAcquisition::RigAcquisition(const config::RigConfig& rig, RigAcquisitionOptio
       aravis.frame_mode = cam.frame_mode;
       if (software_triggers_) aravis.trigger_source = "Software";
       aravis.exposure_time_us = static_cast<double>(plan_.camera.exposure_a_ns) / 1000.0;
+      // Frames wait in the assembler while a set waits for a late or lost frame (up to the set
+      // timeout), and every camera's frames of the sets queued behind it wait too: the pool
+      // must outlast that, or one camera's loss becomes every camera's underrun.
+      const double waiting_s = std::chrono::duration<double>(options_.set_timeout).count() + kQueueAllowance.count();
+      aravis.buffer_count = std::max(aravis.buffer_count,
+                                     static_cast<int>(std::ceil(2.0 * plan_.rate_hz * waiting_s)) + kSpareBuffers);
       if (software_triggers_) {
         // Frames answer triggers a period apart (hardware) or Δt and the rest of the period
         // apart (two_triggers): half the closer spacing tells them apart.

@@ -152,10 +152,9 @@ TEST(GenTLProducerLoading, AnUnknownDeviceListsTheDevicesFound) {
 }
 
 TEST(GenTLProducerLoading, GenicamGenTL64PathFindsTheProducerWhenTheRigNamesNone) {
-  const std::string folder = std::string(TOMORIG_MOCK_GENTL).substr(0, std::string(TOMORIG_MOCK_GENTL).rfind('/'));
-  // The folder holds the broken variants too: the device is looked up producer by producer, and
-  // a broken one is reported, so point at the good file itself.
-  setenv("GENICAM_GENTL64_PATH", ("/nonexistent-dir:" + std::string(TOMORIG_MOCK_GENTL)).c_str(), 1);
+  // A folder that does not exist, a library that is no producer (skipped), then the producer.
+  setenv("GENICAM_GENTL64_PATH",
+         ("/nonexistent-dir:" + std::string(TOMORIG_NOT_A_PRODUCER) + ":" + TOMORIG_MOCK_GENTL).c_str(), 1);
   auto cam = make_gentl_camera("cam0", software_burst());
   auto cfg = gentl_config("cam0", "MOCK0002", "");  // by serial number
   EXPECT_NO_THROW(cam->configure(cfg));
@@ -165,7 +164,17 @@ TEST(GenTLProducerLoading, GenicamGenTL64PathFindsTheProducerWhenTheRigNamesNone
   const std::string message = error_of([&] { other->configure(gentl_config("cam1", "mockcam1", "")); }, &kind);
   EXPECT_EQ(kind, ErrorKind::bad_input);
   EXPECT_NE(message.find("GENICAM_GENTL64_PATH"), std::string::npos) << message;
-  (void)folder;
+}
+
+TEST(GenTLProducerLoading, AnUnknownDeviceOnTheSearchPathNamesTheProducersSkipped) {
+  setenv("GENICAM_GENTL64_PATH", (std::string(TOMORIG_MOCK_GENTL_NO_QUEUE) + ":" + TOMORIG_MOCK_GENTL).c_str(), 1);
+  auto cam = make_gentl_camera("cam0", software_burst());
+  ErrorKind kind{};
+  const std::string message = error_of([&] { cam->configure(gentl_config("cam0", "nosuchcam", "")); }, &kind);
+  unsetenv("GENICAM_GENTL64_PATH");
+  EXPECT_EQ(kind, ErrorKind::runtime);
+  EXPECT_NE(message.find("mockcam0"), std::string::npos) << message;
+  EXPECT_NE(message.find("DSQueueBuffer"), std::string::npos) << message;
 }
 
 // Frames of a software-triggered burst camera: every trigger gives frames A and B, tagged with

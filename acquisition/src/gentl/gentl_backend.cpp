@@ -30,8 +30,21 @@ class GenTLBackend final : public detail::CameraBackend {
     else
       producers = Producer::from_environment();
     std::vector<std::string> seen;
+    std::vector<std::string> unusable;  // GENICAM_GENTL64_PATH only: producers that failed to load
     for (const auto& path : producers) {
-      auto producer = Producer::load(path);
+      std::shared_ptr<Producer> producer;
+      if (!config.producer.empty()) {
+        producer = Producer::load(path);  // the rig's own choice: its errors are the answer
+      } else {
+        // The variable often lists every vendor's producer; one that cannot load (no grabber,
+        // no licence) must not hide the camera on another.
+        try {
+          producer = Producer::load(path);
+        } catch (const Error& e) {
+          unusable.push_back(e.what());
+          continue;
+        }
+      }
       std::shared_ptr<Device> device = producer->open_device(config.device_id);
       if (!device) {
         for (auto& listed : producer->list_devices()) seen.push_back(fmt::format("{} [{}]", listed, path.filename().string()));
@@ -49,9 +62,11 @@ class GenTLBackend final : public detail::CameraBackend {
     }
     throw runtime_error(fmt::format("camera {}: GenTL device '{}' not found. Devices found: {}. Check that the camera "
                                     "is powered and connected to the grabber, and that device_id is an id, serial "
-                                    "number or user-defined name from this list",
+                                    "number or user-defined name from this list{}",
                                     id, config.device_id,
-                                    seen.empty() ? std::string("none") : fmt::format("{}", fmt::join(seen, "; "))));
+                                    seen.empty() ? std::string("none") : fmt::format("{}", fmt::join(seen, "; ")),
+                                    unusable.empty() ? std::string()
+                                                     : fmt::format(". Producers skipped: {}", fmt::join(unusable, "; "))));
   }
 
   // The stream's own size when it defines it (a grabber that adds chunk data or line padding),
