@@ -111,16 +111,20 @@ class GenTLRig : public ::testing::Test {
           EXPECT_NE(tag.frame, 0xEE) << "set " << k << " camera " << c << ": an incomplete buffer was recorded";
           EXPECT_EQ(tag.frame, e) << "set " << k << " camera " << c << ": A and B swapped";
           EXPECT_EQ(tag.camera, static_cast<std::uint32_t>(c)) << "set " << k;
-          if (camera_trigger >= 0)
+          if (camera_trigger >= 0) {
             EXPECT_EQ(camera_trigger, tag.trigger) << "set " << k << " camera " << c << ": A and B of different triggers";
+          }
           camera_trigger = tag.trigger;
         }
-        if (rec.frame_present[c][0] && rec.frame_present[c][1])
+        if (rec.frame_present[c][0] && rec.frame_present[c][1]) {
           EXPECT_EQ(rec.frame_timestamp_ns[c][1] - rec.frame_timestamp_ns[c][0],
                     static_cast<std::int64_t>(kExposureUs * 1000))
               << "set " << k << " camera " << c << ": B - A is not the exposure the rig wrote";
+        }
         if (camera_trigger < 0) continue;
-        if (trigger >= 0) EXPECT_EQ(trigger, camera_trigger) << "set " << k << ": cameras answer different triggers";
+        if (trigger >= 0) {
+          EXPECT_EQ(trigger, camera_trigger) << "set " << k << ": cameras answer different triggers";
+        }
         trigger = camera_trigger;
       }
       triggers.push_back(trigger);
@@ -250,6 +254,7 @@ TEST_F(GenTLRig, UnusableProducersExitWithCode2NamingTheFileAndSymbol) {
     EXPECT_EQ(r.exit_code, 2) << c.producer << "\n" << r.err;
     EXPECT_NE(r.err.find(c.producer), std::string::npos) << r.err;
     EXPECT_NE(r.err.find(c.names), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("camera cam0"), std::string::npos) << r.err;
     EXPECT_FALSE(std::filesystem::exists(out.string() + ".partial"));
   }
 }

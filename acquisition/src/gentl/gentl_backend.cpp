@@ -34,7 +34,11 @@ class GenTLBackend final : public detail::CameraBackend {
     for (const auto& path : producers) {
       std::shared_ptr<Producer> producer;
       if (!config.producer.empty()) {
-        producer = Producer::load(path);  // the rig's own choice: its errors are the answer
+        try {
+          producer = Producer::load(path);  // the rig's own choice: its errors are the answer
+        } catch (const Error& e) {
+          throw Error(e.kind(), fmt::format("camera {}: {}", id, e.what()));
+        }
       } else {
         // The variable often lists every vendor's producer; one that cannot load (no grabber,
         // no licence) must not hide the camera on another.

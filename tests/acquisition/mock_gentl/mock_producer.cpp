@@ -27,6 +27,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <deque>
@@ -306,6 +307,7 @@ struct Device {
   std::vector<std::byte> registers = std::vector<std::byte>(kRegisterBytes);
   std::string xml_blob;  // what the local: URL points at (plain or zipped, NUL padded)
   std::string url;
+  std::string xml_file;  // MOCK_GENTL_XML=file: the description on disk, removed at GCCloseLib
   bool open = false;
   bool acquiring = false;  // AcquisitionStart executed
   std::deque<Trigger> triggers;
@@ -383,6 +385,7 @@ void make_devices() {
       const std::string path = "/tmp/tomorig-mock-gentl-" + std::to_string(getpid()) + "-" + device->id + ".xml";
       std::ofstream(path, std::ios::binary) << xml;
       device->url = "file://" + path + "?SchemaVersion=1.1.0";
+      device->xml_file = path;
     } else {
       const bool zip = options.xml_mode == "zip";
       device->xml_blob = zip ? stored_zip("mock_camera.xml", xml) : xml;
@@ -558,6 +561,7 @@ MOCK_EXPORT Status GCCloseLib() {
     }
     device->wake.notify_all();
     if (device->worker.joinable()) device->worker.join();
+    if (!device->xml_file.empty()) std::remove(device->xml_file.c_str());
   }
   delete the_system;
   the_system = nullptr;
