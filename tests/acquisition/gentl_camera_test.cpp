@@ -362,6 +362,26 @@ TEST(GenTLCamera, DropsAndUnderrunsAreCounted) {
   EXPECT_GE(stats.frame_id_gaps, 4u);  // the last drop (frame 20) leaves no gap behind it
 }
 
+// Stopped and started again (images of the first run still held): the second run streams on
+// the same GenTL data stream, and the first run's images stay intact.
+TEST(GenTLCamera, ARestartStreamsAgainWhileOldImagesAreHeld) {
+  auto cam = make_gentl_camera("cam1", software_burst());
+  ASSERT_NO_THROW(cam->configure(gentl_config("cam1", "mockcam1", TOMORIG_MOCK_GENTL)));
+  Collector first;
+  cam->start(first.sink());
+  for (int t = 0; t < 2; ++t) cam->software_trigger();
+  ASSERT_TRUE(first.wait_for(4));
+  cam->stop();
+  const auto kept = first.take();
+  Collector second;
+  cam->start(second.sink());
+  for (int t = 0; t < 3; ++t) cam->software_trigger();
+  ASSERT_TRUE(second.wait_for(6));
+  cam->stop();
+  expect_burst_pairs(kept, 1);
+  expect_burst_pairs(second.take(), 1);  // AcquisitionStart restarts the mock's trigger count
+}
+
 // A camera that stops answering triggers is noticed (frame timeout) and marked disconnected.
 TEST(GenTLCamera, ACameraThatStopsAnsweringIsMarkedDisconnected) {
   AravisCameraOptions o = software_burst();

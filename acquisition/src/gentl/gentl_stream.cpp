@@ -126,18 +126,23 @@ std::shared_ptr<GenTLFrameStream> GenTLFrameStream::create(std::shared_ptr<DataS
 }
 
 GenTLFrameStream::~GenTLFrameStream() {
-  const auto& f = stream_->fn();
-  const gentl::Handle ds = stream_->handle();
   stop();
-  if (event_ != nullptr) f.GCUnregisterEvent(ds, gentl::kEventNewBuffer);
-  f.DSFlushQueue(ds, gentl::kQueueAllDiscard);
-  for (auto* buffer : buffers_) f.DSRevokeBuffer(ds, buffer, nullptr, nullptr);
+  // Images of this stream may have outlived it by a restart: its buffers only are revoked.
+  for (auto* buffer : buffers_) stream_->fn().DSRevokeBuffer(stream_->handle(), buffer, nullptr, nullptr);
   // memory_ goes after the producer forgot every buffer.
 }
 
+// Everything that ties the data stream to this object ends here, not in the destructor: a
+// restarted camera opens a new GenTLFrameStream on the same data stream while images of this
+// one may still be alive.
 void GenTLFrameStream::stop() {
   if (!started_.exchange(false)) return;
-  stream_->fn().DSStopAcquisition(stream_->handle(), gentl::kStopDefault);
+  const auto& f = stream_->fn();
+  const gentl::Handle ds = stream_->handle();
+  f.DSStopAcquisition(ds, gentl::kStopDefault);
+  if (event_ != nullptr) f.GCUnregisterEvent(ds, gentl::kEventNewBuffer);
+  event_ = nullptr;
+  f.DSFlushQueue(ds, gentl::kQueueAllDiscard);
 }
 
 template <typename T>
@@ -149,6 +154,7 @@ bool GenTLFrameStream::buffer_info(gentl::Handle buffer, std::int32_t cmd, T& ou
 }
 
 std::optional<detail::StreamBuffer> GenTLFrameStream::pop(std::chrono::microseconds timeout) {
+  if (!started_) return std::nullopt;  // stopped: the event is gone (the delivery thread has ended)
   gentl::NewBufferEventData data{};
   std::size_t size = sizeof data;
   const auto timeout_ms = static_cast<std::uint64_t>(std::max<std::int64_t>(1, timeout.count() / 1000));

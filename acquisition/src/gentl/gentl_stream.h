@@ -63,7 +63,7 @@ class GenTLFrameStream final : public detail::FrameStream, public std::enable_sh
   std::vector<std::unique_ptr<std::byte[], AlignedDelete>> memory_;
   std::uint64_t tick_hz_ = 0;  // the device's timestamp frequency; 0: unknown
   std::vector<gentl::Handle> buffers_;
-  gentl::Handle event_ = nullptr;
+  gentl::Handle event_ = nullptr;  // NEW_BUFFER, registered from create() to stop()
   std::atomic<bool> started_{false};
   std::atomic<std::uint64_t> completed_{0};
   std::atomic<std::uint64_t> failures_{0};
