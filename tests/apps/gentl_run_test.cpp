@@ -162,11 +162,16 @@ TEST_F(GenTLRig, FourCamerasRecord200DoubleFrameSetsWithoutLossAndCorrectPairs) 
   }
 }
 
-// A producer without the GenTL 1.3+ functions records the same.
+// An older producer (no GenTL 1.3+ functions, timestamps in ticks, aligned buffers) serving a
+// zipped description of cameras without PayloadSize records the same.
 TEST_F(GenTLRig, AProducerWithoutOptionalFunctionsRecords) {
   write_rig(rig_toml(TOMORIG_MOCK_GENTL_V12));
   const auto out = (dir_ / "v12.h5").string();
+  setenv("MOCK_GENTL_XML", "zip", 1);
+  setenv("MOCK_GENTL_NO_PAYLOADSIZE", "1", 1);
   const CliResult r = run(20, out);
+  unsetenv("MOCK_GENTL_XML");
+  unsetenv("MOCK_GENTL_NO_PAYLOADSIZE");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const storage::SessionReader session(out);
   EXPECT_EQ(session.missing_frames(), 0) << r.err;
