@@ -10,22 +10,26 @@
 #include <memory>
 #include <vector>
 
+#include "frame_stream.h"
+
 namespace tomorig::acquisition::detail {
 
-class AravisBufferPool : public std::enable_shared_from_this<AravisBufferPool> {
+class AravisBufferPool final : public FrameStream, public std::enable_shared_from_this<AravisBufferPool> {
  public:
   // Takes a reference on `stream`; allocates `count` buffers of `payload_bytes` and queues
   // them on the stream.
   static std::shared_ptr<AravisBufferPool> create(ArvStream* stream, std::size_t payload_bytes, int count);
-  ~AravisBufferPool();
+  ~AravisBufferPool() override;
   AravisBufferPool(const AravisBufferPool&) = delete;
   AravisBufferPool& operator=(const AravisBufferPool&) = delete;
 
   ArvStream* stream() const { return stream_; }
-  // Gives `buffer` back to the stream.
-  void give_back(ArvBuffer* buffer);
+  std::optional<StreamBuffer> pop(std::chrono::microseconds timeout) override;
+  // Gives `buffer` (an ArvBuffer*) back to the stream.
+  void give_back(void* buffer) override;
   // A lease that gives `buffer` back when its last copy dies.
-  std::shared_ptr<void> lease(ArvBuffer* buffer);
+  std::shared_ptr<void> lease(void* buffer) override;
+  StreamCounters counters() const override;
 
  private:
   AravisBufferPool() = default;

@@ -11,7 +11,7 @@
 #include <mutex>
 #include <thread>
 
-#include "aravis_buffer_pool.h"
+#include "camera_backend.h"
 #include "genicam_features.h"
 #include "glib_handles.h"
 #include "tomorig/acquisition/frame_id.h"
@@ -24,19 +24,8 @@ namespace {
 using detail::GErrorSlot;
 using detail::GObjectPtr;
 
-constexpr guint64 kPopTimeoutUs = 50'000;  // how often the delivery thread checks for stop() and lost frames
-
-// Sample type of the pixel formats tomorig stores; nullopt for packed or colour formats.
-std::optional<SampleType> sample_type_of_arv(ArvPixelFormat format) {
-  switch (format) {
-    case ARV_PIXEL_FORMAT_MONO_8: return SampleType::u8;
-    case ARV_PIXEL_FORMAT_MONO_10:
-    case ARV_PIXEL_FORMAT_MONO_12:
-    case ARV_PIXEL_FORMAT_MONO_14:
-    case ARV_PIXEL_FORMAT_MONO_16: return SampleType::u16;
-    default: return std::nullopt;
-  }
-}
+// How often the delivery thread checks for stop() and lost frames.
+constexpr std::chrono::microseconds kPopTimeout{50'000};
 
 }  // namespace
 
@@ -66,6 +55,7 @@ int frames_per_trigger(config::FrameMode mode) { return mode == config::FrameMod
 struct AravisCamera::Impl {
   std::string id;
   AravisCameraOptions options;
+  std::unique_ptr<detail::CameraBackend> backend;
   config::CameraConfig config;
   GObjectPtr<ArvCamera> camera;
   gulong control_lost_handler = 0;
@@ -93,7 +83,7 @@ struct AravisCamera::Impl {
   std::unique_ptr<TriggerMatcher> matcher;
   std::atomic<std::uint64_t> unmatched{0};
 
-  std::shared_ptr<detail::AravisBufferPool> pool;  // kept after stop() so statistics stay readable
+  std::shared_ptr<detail::FrameStream> pool;  // kept after stop() so statistics stay readable
   mutable std::mutex pool_mutex;  // guards the `pool` pointer for statistics() (sinks may call it)
   std::size_t payload = 0;
 
@@ -105,11 +95,11 @@ struct AravisCamera::Impl {
   std::atomic<std::uint64_t> frame_id_gaps{0};
   std::atomic<std::uint64_t> rejected{0};  // complete buffers refused (size, pixel format)
 
-  void open(const std::string& device_id);
+  void open(const config::CameraConfig& cfg);
   void apply(const config::CameraConfig& cfg);
   void apply_frame_mode(ArvDevice* device, const config::CameraConfig& cfg);
   void deliver_loop();
-  void deliver(ArvBuffer* buffer, FrameIdUnwrapper& unwrapper);
+  void deliver(const detail::StreamBuffer& buffer, FrameIdUnwrapper& unwrapper);
   void trigger_loop();
   bool send_trigger();  // false: the command failed and the camera is marked disconnected
   void trigger_taken();
@@ -207,18 +197,8 @@ void AravisCamera::Impl::forget_camera() {
   camera.reset();
 }
 
-void AravisCamera::Impl::open(const std::string& device_id) {
-  GErrorSlot error;
-  ArvCamera* opened = arv_camera_new(device_id.c_str(), error.out());
-  if (opened == nullptr) {
-    const auto found = list_aravis_devices();
-    throw runtime_error(fmt::format(
-        "camera {}: Aravis device '{}' not found ({}). Devices found: {}. Check that the camera is powered and "
-        "connected, and that device_id is an id or address from this list",
-        id, device_id, error ? error.message() : "no such device",
-        found.empty() ? std::string("none") : fmt::format("{}", fmt::join(found, ", "))));
-  }
-  camera.reset(opened);
+void AravisCamera::Impl::open(const config::CameraConfig& cfg) {
+  camera.reset(backend->open(id, cfg));
   control_lost_handler =
       g_signal_connect(arv_camera_get_device(camera.get()), "control-lost", G_CALLBACK(on_control_lost), this);
 }
@@ -251,10 +231,7 @@ void AravisCamera::Impl::apply(const config::CameraConfig& cfg) {
   }
   for (const auto& [name, value] : cfg.features) detail::set_feature(device, id, name, value);
 
-  GErrorSlot error;
-  payload = arv_camera_get_payload(camera.get(), error.out());
-  if (error || payload == 0)
-    throw runtime_error(fmt::format("camera {}: cannot read the payload size: {}", id, error.message()));
+  payload = backend->payload(camera.get(), id);
 }
 
 // The frame mode as GenICam (SFNC) features. A double-frame ("hardware") camera answers one
@@ -302,37 +279,35 @@ void AravisCamera::Impl::apply_frame_mode(ArvDevice* device, const config::Camer
     detail::set_feature(device, id, "TriggerActivation", options.trigger_activation);
 }
 
-void AravisCamera::Impl::deliver(ArvBuffer* buffer, FrameIdUnwrapper& unwrapper) {
-  const guint64 raw_id = arv_buffer_get_frame_id(buffer);
+void AravisCamera::Impl::deliver(const detail::StreamBuffer& buffer, FrameIdUnwrapper& unwrapper) {
+  const std::uint64_t raw_id = buffer.frame_id;
   if (raw_id == 0 && options.frame_id_zero_reserved) {  // failed before any packet said which frame
-    pool->give_back(buffer);
+    pool->give_back(buffer.token);
     return;
   }
   const auto sequence = unwrapper.unwrap(raw_id);
   frame_id_gaps = unwrapper.gaps();
   if (sequence) frames_seen(*sequence);  // failed or not, the camera answered its trigger
   // Incomplete or corrupt buffers still move the frame-id sequence (so later frames keep
-  // their A/B role) but are never delivered: Aravis counts them as failures.
+  // their A/B role) but are never delivered: the stream counts them as failures.
   if (!sequence) {  // stale or duplicate id: not a frame of this acquisition's sequence
-    pool->give_back(buffer);
+    pool->give_back(buffer.token);
     return;
   }
   auto reject = [&] {
-    pool->give_back(buffer);
+    pool->give_back(buffer.token);
     if (options.on_failed_frame) options.on_failed_frame(*sequence);
   };
-  if (arv_buffer_get_status(buffer) != ARV_BUFFER_STATUS_SUCCESS) {
+  if (!buffer.complete) {
     reject();
     return;
   }
-  const auto type = sample_type_of_arv(arv_buffer_get_image_pixel_format(buffer));
-  const int width = arv_buffer_get_image_width(buffer);
-  const int height = arv_buffer_get_image_height(buffer);
-  std::size_t size = 0;
-  const void* data = arv_buffer_get_image_data(buffer, &size);
-  if (!type || width <= 0 || height <= 0 || data == nullptr ||
-      size < static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * bytes_per_sample(*type)) {
-    ++rejected;  // Aravis saw a good buffer; tomorig cannot use it, so it is a failure too
+  const auto type = buffer.type;
+  const int width = buffer.width;
+  const int height = buffer.height;
+  if (!type || width <= 0 || height <= 0 || buffer.data == nullptr ||
+      buffer.size < static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * bytes_per_sample(*type)) {
+    ++rejected;  // the stream saw a good buffer; tomorig cannot use it, so it is a failure too
     reject();
     return;
   }
@@ -340,19 +315,23 @@ void AravisCamera::Impl::deliver(ArvBuffer* buffer, FrameIdUnwrapper& unwrapper)
   frame.frame_id = *sequence;
   frame.trigger_index = *sequence / 2;
   frame.exposure = *sequence % 2 == 0 ? Exposure::A : Exposure::B;
-  frame.timestamp_ns = static_cast<std::int64_t>(arv_buffer_get_timestamp(buffer));
+  frame.timestamp_ns = buffer.timestamp_ns;
   if (matcher) {
     // The camera numbers frames, not events: the trigger it answers is found by time.
-    const auto hit = matcher->match(*sequence, frame.timestamp_ns);
+    // Double-frame bursts alternate A, B in the frame counter: that says which frame this is
+    // when its partner was lost; the matcher finds the trigger by time.
+    const std::optional<Exposure> burst_position =
+        options.frame_mode == config::FrameMode::hardware ? std::optional(frame.exposure) : std::nullopt;
+    const auto hit = matcher->match(*sequence, frame.timestamp_ns, burst_position);
     if (!hit || !hit->event) {  // a warm-up frame, or one no trigger explains
       if (!hit) ++unmatched;
-      pool->give_back(buffer);
+      pool->give_back(buffer.token);
       return;
     }
     frame.trigger_index = *hit->event;
     frame.exposure = hit->exposure;
   }
-  frame.image = Image::view(const_cast<void*>(data), width, height, *type, 0, pool->lease(buffer));
+  frame.image = Image::view(const_cast<void*>(buffer.data), width, height, *type, 0, pool->lease(buffer.token));
   ++delivered;
   sink(std::move(frame));
 }
@@ -361,13 +340,17 @@ void AravisCamera::Impl::deliver_loop() {
   FrameIdUnwrapper unwrapper(options.frame_id_bits, options.frame_id_zero_reserved);
   if (options.first_frame_id) unwrapper.expect_first(*options.first_frame_id);
   while (running) {
-    ArvBuffer* buffer = arv_stream_timeout_pop_buffer(pool->stream(), kPopTimeoutUs);
-    if (buffer != nullptr) deliver(buffer, unwrapper);
+    if (const auto buffer = pool->pop(kPopTimeout)) deliver(*buffer, unwrapper);
     check_unanswered();
   }
 }
 
-AravisCamera::AravisCamera(std::string id, AravisCameraOptions options) : impl_(std::make_unique<Impl>()) {
+AravisCamera::AravisCamera(std::string id, AravisCameraOptions options)
+    : AravisCamera(std::move(id), std::move(options), detail::make_aravis_backend()) {}
+
+AravisCamera::AravisCamera(std::string id, AravisCameraOptions options, std::unique_ptr<detail::CameraBackend> backend)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->backend = std::move(backend);
   if (id.empty()) throw bad_input("aravis camera: the camera id is empty");
   if (options.buffer_count < 2)
     throw bad_input(fmt::format("camera {}: buffer_count = {}: must be >= 2", id, options.buffer_count));
@@ -397,14 +380,12 @@ int AravisCamera::triggers_per_set() const {
 void AravisCamera::configure(const config::CameraConfig& config) {
   std::lock_guard lock(impl_->mutex);
   if (impl_->running) throw runtime_error(fmt::format("camera {}: cannot configure while running; stop it first", impl_->id));
-  if (config.backend != config::CameraBackend::aravis)
-    throw bad_input(fmt::format("camera {}: backend is '{}', but an Aravis camera was asked to take it", impl_->id,
-                                config::to_string(config.backend)));
-  if (config.device_id.empty())
-    throw bad_input(fmt::format("camera {}: device_id is empty: give the Aravis device id or IP address", impl_->id));
-  if (!impl_->camera || config.device_id != impl_->config.device_id) {
+  if (config.backend != impl_->backend->kind())
+    throw bad_input(fmt::format("camera {}: backend is '{}', but a '{}' camera was asked to take it", impl_->id,
+                                config::to_string(config.backend), config::to_string(impl_->backend->kind())));
+  if (!impl_->camera || config.device_id != impl_->config.device_id || config.producer != impl_->config.producer) {
     impl_->forget_camera();
-    impl_->open(config.device_id);
+    impl_->open(config);
   }
   impl_->config = config;
   impl_->apply(config);
@@ -415,24 +396,12 @@ void AravisCamera::start(FrameSink sink) {
   std::lock_guard lock(impl_->mutex);
   if (impl_->running) return;
   if (!impl_->camera) throw runtime_error(fmt::format("camera {}: start() before configure()", impl_->id));
-  GErrorSlot error;
-  ArvStream* stream = arv_camera_create_stream(impl_->camera.get(), nullptr, nullptr, error.out());
-  if (stream == nullptr)
-    throw runtime_error(fmt::format("camera {}: cannot open the stream: {}", impl_->id, error.message()));
-  GObjectPtr<ArvStream> stream_ref(stream);
-  if (ARV_IS_GV_STREAM(stream)) {
-    if (impl_->options.socket_buffer_bytes > 0)
-      g_object_set(stream, "socket-buffer", ARV_GV_STREAM_SOCKET_BUFFER_FIXED, "socket-buffer-size",
-                   impl_->options.socket_buffer_bytes, nullptr);
-    if (impl_->options.frame_retention_us > 0)
-      g_object_set(stream, "frame-retention", static_cast<guint>(impl_->options.frame_retention_us), nullptr);
-    // Ask for lost packets again rather than accept a frame with holes.
-    g_object_set(stream, "packet-resend", ARV_GV_STREAM_PACKET_RESEND_ALWAYS, nullptr);
-  }
   {
+    auto stream = impl_->backend->open_stream(impl_->camera.get(), impl_->payload, impl_->options, impl_->id);
     std::lock_guard pool_lock(impl_->pool_mutex);
-    impl_->pool = detail::AravisBufferPool::create(stream, impl_->payload, impl_->options.buffer_count);
+    impl_->pool = std::move(stream);
   }
+  GErrorSlot error;
   impl_->sink = std::move(sink);
   impl_->delivered = 0;
   impl_->frame_id_gaps = 0;
@@ -476,6 +445,10 @@ void AravisCamera::stop() {
   // A camera known to be gone would make AcquisitionStop wait out every GVCP retry.
   GErrorSlot error;
   if (impl_->camera && !impl_->disconnected) arv_camera_stop_acquisition(impl_->camera.get(), error.out());
+  {
+    std::lock_guard pool_lock(impl_->pool_mutex);
+    if (impl_->pool) impl_->pool->stop();
+  }
   impl_->sink = nullptr;
 }
 
@@ -511,23 +484,18 @@ StreamStatistics AravisCamera::statistics() const {
   StreamStatistics s;
   s.delivered = impl_->delivered;
   s.frame_id_gaps = impl_->frame_id_gaps;
-  std::shared_ptr<detail::AravisBufferPool> pool;
+  std::shared_ptr<detail::FrameStream> pool;
   {
     std::lock_guard pool_lock(impl_->pool_mutex);
     pool = impl_->pool;
   }
   if (!pool) return s;
-  guint64 completed = 0, failures = 0, underruns = 0;
-  arv_stream_get_statistics(pool->stream(), &completed, &failures, &underruns);
-  s.completed = completed;
-  s.failures = failures + impl_->rejected;
-  s.underruns = underruns;
-  if (ARV_IS_GV_STREAM(pool->stream())) {
-    guint64 resent = 0, missing = 0;
-    arv_gv_stream_get_statistics(ARV_GV_STREAM(pool->stream()), &resent, &missing);
-    s.resends = resent;
-    s.missing_packets = missing;
-  }
+  const detail::StreamCounters c = pool->counters();
+  s.completed = c.completed;
+  s.failures = c.failures + impl_->rejected;
+  s.underruns = c.underruns;
+  s.resends = c.resends;
+  s.missing_packets = c.missing_packets;
   return s;
 }
 

@@ -28,14 +28,16 @@ void TriggerMatcher::expect(const Trigger& trigger) {
   pending_.push_back(trigger);
 }
 
-std::optional<TriggerMatcher::Match> TriggerMatcher::match(std::uint64_t frame_id, std::int64_t timestamp_ns) {
+std::optional<TriggerMatcher::Match> TriggerMatcher::match(std::uint64_t frame_id, std::int64_t timestamp_ns,
+                                                           std::optional<Exposure> burst_position) {
   std::lock_guard lock(mutex_);
   // Frame B of a double-frame camera: the frame right after its trigger's frame A.
   if (open_pair_) {
     const Trigger pair = *open_pair_;
     open_pair_.reset();
-    if (frame_id == open_pair_frame_id_ + 1) return Match{pair.event, Exposure::B};
+    if (frame_id == open_pair_frame_id_ + 1 && burst_position != Exposure::A) return Match{pair.event, Exposure::B};
   }
+  const bool lone_b = frames_per_trigger_ == 2 && burst_position == Exposure::B;
   if (pending_.empty()) {
     ++unmatched_;
     return std::nullopt;
@@ -82,6 +84,9 @@ std::optional<TriggerMatcher::Match> TriggerMatcher::match(std::uint64_t frame_i
   pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(best));
   const Trigger hit = pending_.front();
   pending_.pop_front();
+  // Frame B whose frame A never came: its trigger, by time (B follows A by far less than the
+  // tolerance); it teaches no offset and opens no pair.
+  if (lone_b) return Match{hit.event, Exposure::B};
   // A warm-up frame teaches nothing: a camera that is not ready yet answers late.
   if (hit.event) {
     auto& offsets = offsets_[hit.exposure == Exposure::A ? 0 : 1];

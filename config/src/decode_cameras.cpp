@@ -20,7 +20,7 @@ namespace {
 constexpr int kMaxImageSidePx = 1 << 16;
 
 constexpr Choice<CameraBackend> kCameraBackends[] = {
-    {"aravis", CameraBackend::aravis}, {"simulated", CameraBackend::simulated}};
+    {"aravis", CameraBackend::aravis}, {"simulated", CameraBackend::simulated}, {"gentl", CameraBackend::gentl}};
 
 constexpr Choice<FrameMode> kFrameModes[] = {{"hardware", FrameMode::hardware},
                                              {"two_triggers", FrameMode::two_triggers},
@@ -84,10 +84,18 @@ void decode_camera(TableReader& r, const TriggerConfig& trigger, CameraConfig& c
   const bool backend_known = r.read_choice("backend", backend, kCameraBackends, Need::required);
   if (backend_known) cam.backend = backend;
   const bool aravis = backend_known && backend == CameraBackend::aravis;
+  const bool gentl = backend_known && backend == CameraBackend::gentl;
   const bool simulated = backend_known && backend == CameraBackend::simulated;
 
-  r.read("device_id", cam.device_id, aravis ? Need::required : Need::optional, not_empty());
+  r.read("device_id", cam.device_id, aravis || gentl ? Need::required : Need::optional, not_empty());
   if (cam.device_id.empty() && simulated) cam.device_id = cam.id;
+  // The producer is checked when the camera opens (it may live on the acquisition host only).
+  std::string producer;
+  if (r.read("producer", producer, Need::optional, not_empty())) {
+    if (backend_known && !gentl)
+      r.issue("producer", "is for backend = \"gentl\" cameras (the GenTL producer's .cti file); remove it");
+    cam.producer = producer;
+  }
 
   std::string format;
   if (r.read("pixel_format", format)) {
@@ -107,7 +115,7 @@ void decode_camera(TableReader& r, const TriggerConfig& trigger, CameraConfig& c
                             "least time from the end of one exposure to the next trigger the camera takes, about "
                             "1 / its top frame rate at this ROI)");
     if (cam.frame_mode == FrameMode::free_run && simulated)
-      r.issue("frame_mode", "\"free_run\" is for aravis cameras; a simulated camera is exposed by every trigger event "
+      r.issue("frame_mode", "\"free_run\" is for aravis and gentl cameras; a simulated camera is exposed by every trigger event "
                             "(use \"hardware\" or \"two_triggers\")");
   }
 

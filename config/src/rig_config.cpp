@@ -106,6 +106,7 @@ std::string_view to_string(CameraBackend b) {
   switch (b) {
     case CameraBackend::aravis: return "aravis";
     case CameraBackend::simulated: return "simulated";
+    case CameraBackend::gentl: return "gentl";
   }
   return "unknown";
 }

@@ -11,6 +11,7 @@
 
 #include "tomorig/rig/simulate_session.h"
 #include "tomorig/acquisition/aravis_camera.h"
+#include "tomorig/acquisition/gentl_camera.h"
 #include "tomorig/core/error.h"
 #include "tomorig/simulators/simulated_rig.h"
 #include "tomorig/trigger/rig_trigger.h"
@@ -23,6 +24,10 @@ using Clock = std::chrono::steady_clock;
 
 // How often the loop looks up from waiting for an event to check for a stop or the duration.
 constexpr std::chrono::milliseconds kEventPoll{50};
+// Camera buffer pools: besides the set timeout, the time a set may wait to be taken from the
+// assembler and written, and a few buffers in flight in the stream itself.
+constexpr std::chrono::duration<double> kQueueAllowance{0.5};
+constexpr int kSpareBuffers = 8;
 
 // How the assembler checks a camera's pairs: B - A of its timestamps against the plan's frame
 // separation (Aravis cameras; a simulated camera stamps frames with the trigger's own times).
@@ -34,7 +39,7 @@ acquisition::AssemblerOptions::CameraPairing pairing_of(const config::CameraConf
     pairing.free_running = true;
     return pairing;
   }
-  if (cam.backend != config::CameraBackend::aravis) return pairing;
+  if (cam.backend == config::CameraBackend::simulated) return pairing;
   pairing.expected_separation_ns = plan.frame_separation_ns();
   if (timing.frame_time_tolerance_us) {
     pairing.tolerance_ns = std::llround(*timing.frame_time_tolerance_us * 1000.0);
@@ -79,7 +84,7 @@ RigAcquisition::RigAcquisition(const config::RigConfig& rig, RigAcquisitionOptio
   std::size_t simulated = 0;
   for (const auto& cam : rig_.cameras) simulated += cam.backend == config::CameraBackend::simulated ? 1 : 0;
   if (simulated != 0 && simulated != rig_.cameras.size())
-    throw bad_input("the rig mixes simulated and aravis cameras; use one backend for every camera");
+    throw bad_input("the rig mixes simulated and real (aravis, gentl) cameras; use simulated cameras for all or none");
   for (const auto& [id, fault] : options_.faults) {
     bool known = false;
     for (const auto& cam : rig_.cameras) known |= cam.id == id && cam.backend == config::CameraBackend::simulated;
@@ -138,6 +143,12 @@ RigAcquisition::RigAcquisition(const config::RigConfig& rig, RigAcquisitionOptio
       aravis.frame_mode = cam.frame_mode;
       if (software_triggers_) aravis.trigger_source = "Software";
       aravis.exposure_time_us = static_cast<double>(plan_.camera.exposure_a_ns) / 1000.0;
+      // Frames wait in the assembler while a set waits for a late or lost frame (up to the set
+      // timeout), and every camera's frames of the sets queued behind it wait too: the pool
+      // must outlast that, or one camera's loss becomes every camera's underrun.
+      const double waiting_s = std::chrono::duration<double>(options_.set_timeout).count() + kQueueAllowance.count();
+      aravis.buffer_count = std::max(aravis.buffer_count,
+                                     static_cast<int>(std::ceil(2.0 * plan_.rate_hz * waiting_s)) + kSpareBuffers);
       if (software_triggers_) {
         // Frames answer triggers a period apart (hardware) or Δt and the rest of the period
         // apart (two_triggers): half the closer spacing tells them apart.
@@ -147,7 +158,9 @@ RigAcquisition::RigAcquisition(const config::RigConfig& rig, RigAcquisitionOptio
                                          : plan_.period_ns;
         aravis.match_tolerance_ns = closest / 2;
       }
-      auto camera = std::make_unique<acquisition::AravisCamera>(cam.id, aravis);
+      // GenTL cameras (frame grabbers) are Aravis-engine cameras reached through a producer.
+      auto camera = cam.backend == config::CameraBackend::gentl ? acquisition::make_gentl_camera(cam.id, aravis)
+                                                                : std::make_unique<acquisition::AravisCamera>(cam.id, aravis);
       camera->configure(cam);  // an absent camera or a refused feature is named here
       session_cameras_.push_back({cam.id, cam.roi.width, cam.roi.height, cam.pixel_format, cam.pixel_pitch_um});
       aravis_cameras_.push_back(camera.get());

@@ -92,6 +92,32 @@ TEST(TriggerMatcher, DoubleFrameCamerasGiveFrameBRightAfterFrameA) {
   EXPECT_EQ(m.triggers_lost(), 1u);
 }
 
+// Frames whose partner was lost: with the burst position from the frame counter, a lone
+// frame B stays B of its own trigger and the next trigger's frame A is not taken for its B.
+TEST(TriggerMatcher, ALoneFrameBKeepsItsRoleAndTrigger) {
+  TriggerMatcher m(2, 100 * kMs);
+  for (std::uint64_t k = 0; k < 4; ++k) m.expect({k, Exposure::A, static_cast<std::int64_t>(k) * 200 * kMs});
+  EXPECT_EQ(m.match(0, kCameraClock, Exposure::A)->exposure, Exposure::A);
+  EXPECT_EQ(m.match(1, kCameraClock + 300'000, Exposure::B)->exposure, Exposure::B);
+  // Event 1's frame A (id 2) was lost: its frame B comes alone.
+  const auto b1 = m.match(3, kCameraClock + 200 * kMs + 300'000, Exposure::B);
+  ASSERT_TRUE(b1);
+  EXPECT_EQ(b1->event, 1u);
+  EXPECT_EQ(b1->exposure, Exposure::B);
+  // Event 2's frame B (id 5) was lost: frame A of event 3 (id 6) follows frame A of event 2.
+  const auto a2 = m.match(4, kCameraClock + 400 * kMs, Exposure::A);
+  EXPECT_EQ(a2->event, 2u);
+  EXPECT_EQ(a2->exposure, Exposure::A);
+  const auto a3 = m.match(6, kCameraClock + 600 * kMs, Exposure::A);
+  EXPECT_EQ(a3->event, 3u);
+  EXPECT_EQ(a3->exposure, Exposure::A);
+  EXPECT_EQ(m.triggers_lost(), 0u);
+  // Without the position (the old behaviour), a lone B would have been taken for a frame A.
+  TriggerMatcher blind(2, 100 * kMs);
+  blind.expect({0, Exposure::A, 0});
+  EXPECT_EQ(blind.match(1, kCameraClock + 300'000)->exposure, Exposure::A);
+}
+
 TEST(TriggerMatcher, OptionsAreChecked) {
   EXPECT_THROW(TriggerMatcher(3, kMs), Error);
   EXPECT_THROW(TriggerMatcher(1, 0), Error);

@@ -439,7 +439,10 @@ INSTANTIATE_TEST_SUITE_P(
                   "-5 must be > 0"},
         RangeCase{"yaw", rig_with("yaw_deg = 270"), "cameras[0].yaw_deg", "yaw_deg", "270 must be in [-180, 180]"},
         RangeCase{"camera_backend", rig_with("", "[[cameras]]\nid = \"b\"\nbackend = \"gige\"\n"),
-                  "cameras[1].backend", "gige", "\"gige\" must be one of aravis, simulated"},
+                  "cameras[1].backend", "gige", "\"gige\" must be one of aravis, simulated, gentl"},
+        RangeCase{"producer_on_aravis",
+                  rig_with("", "[[cameras]]\nid = \"g\"\nbackend = \"aravis\"\ndevice_id = \"d\"\nproducer = \"x.cti\"\n"),
+                  "cameras[1].producer", "producer", "is for backend = \"gentl\" cameras"},
         RangeCase{"empty_id", rig_with("", "[[cameras]]\nid = \"\"\nbackend = \"aravis\"\ndevice_id = \"d\"\n"),
                   "cameras[1].id", "id = \"\"", "\"\" must not be empty"},
         RangeCase{"algorithm", rig_with("", "[processing]\nalgorithm = \"art\"\n"), "processing.algorithm", "art",
@@ -459,6 +462,20 @@ INSTANTIATE_TEST_SUITE_P(
         RangeCase{"calibration_file", rig_with("", "[calibration]\nfile = \"\"\n"), "calibration.file", "file",
                   "must not be empty"}),
     [](const ::testing::TestParamInfo<RangeCase>& info) { return std::string(info.param.name); });
+
+// A gentl camera needs its device; its producer path is kept for the camera to check.
+TEST(RigIssues, GentlCamerasNeedADeviceIdAndKeepTheirProducer) {
+  const auto issues = check_rig_config(rig_with("", "[[cameras]]\nid = \"g\"\nbackend = \"gentl\"\n"));
+  ASSERT_EQ(issues.size(), 1u);
+  EXPECT_EQ(issues[0].key, "cameras[1].device_id");
+  EXPECT_NE(issues[0].message.find("required"), std::string::npos) << issues[0].message;
+  const RigConfig rig = parse_rig_config(rig_with(
+      "", "[[cameras]]\nid = \"g\"\nbackend = \"gentl\"\ndevice_id = \"CXP-1\"\nproducer = \"/opt/x/grabber.cti\"\n"));
+  EXPECT_EQ(rig.cameras.at(1).backend, CameraBackend::gentl);
+  EXPECT_EQ(rig.cameras.at(1).device_id, "CXP-1");
+  EXPECT_EQ(rig.cameras.at(1).producer, std::filesystem::path("/opt/x/grabber.cti"));
+  EXPECT_EQ(to_string(CameraBackend::gentl), "gentl");
+}
 
 TEST(RigIssues, AllIssuesAreCollectedInLineOrder) {
   const std::string doc = R"(name = "many problems"

@@ -1,6 +1,9 @@
 #pragma once
-// A GenICam camera (GigE Vision or USB3 Vision) through Aravis 0.8. Aravis and GLib stay in
-// src/; this header only names the options.
+// A GenICam camera through Aravis 0.8's GenApi engine: GigE Vision or USB3 Vision cameras
+// Aravis finds itself (backend "aravis"), or a frame grabber's cameras through a GenTL
+// producer (backend "gentl", make_gentl_camera in gentl_camera.h). Both share everything but
+// how the device is opened and where the frames come from. Aravis and GLib stay in src/;
+// this header only names the options.
 //
 //   AravisCameraOptions opt;  opt.trigger_source = "Software";
 //   AravisCamera cam("cam0", opt);
@@ -17,6 +20,9 @@
 #include "tomorig/acquisition/camera.h"
 
 namespace tomorig::acquisition {
+namespace detail {
+class CameraBackend;
+}
 
 struct AravisCameraOptions {
   // GenICam settings applied by configure(), before the [cameras.features] of the
@@ -63,6 +69,8 @@ struct AravisCameraOptions {
 class AravisCamera final : public Camera {
  public:
   AravisCamera(std::string id, AravisCameraOptions options = {});
+  // A camera reached another way (a GenTL producer): see make_gentl_camera.
+  AravisCamera(std::string id, AravisCameraOptions options, std::unique_ptr<detail::CameraBackend> backend);
   ~AravisCamera() override;
 
   const std::string& id() const override;

@@ -42,7 +42,13 @@ class TriggerMatcher {
   void expect(const Trigger& trigger);  // in the order the triggers are sent; thread-safe
   // The trigger `frame_id` (unwrapped frame counter) with camera timestamp `timestamp_ns`
   // answers, or nullopt (no trigger near it: the frame belongs to no set). Thread-safe.
-  std::optional<Match> match(std::uint64_t frame_id, std::int64_t timestamp_ns);
+  // burst_position (frames_per_trigger 2): the frame's place in its burst when the caller
+  // knows it from the frame counter (bursts of two: even ids A, odd B). A frame B whose frame
+  // A never arrived (incomplete, dropped) is then found by time and stays frame B, and a frame
+  // A right after a lone frame B is not mistaken for that B's partner. Without it, a frame
+  // that is not the id after an open frame A is taken for a frame A.
+  std::optional<Match> match(std::uint64_t frame_id, std::int64_t timestamp_ns,
+                             std::optional<Exposure> burst_position = std::nullopt);
 
   std::uint64_t triggers_lost() const;   // passed over: their frames never came
   std::uint64_t frames_unmatched() const;

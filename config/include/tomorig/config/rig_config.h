@@ -14,7 +14,7 @@
 
 namespace tomorig::config {
 
-enum class CameraBackend : std::uint8_t { aravis, simulated };
+enum class CameraBackend : std::uint8_t { aravis, simulated, gentl };
 enum class TriggerBackend : std::uint8_t { gpio, simulated };
 
 // How a camera makes the two frames of a set (docs/configuration.md, frame_mode).
@@ -32,7 +32,10 @@ struct Roi {
 struct CameraConfig {
   std::string id;                               // unique, e.g. "cam0"
   CameraBackend backend = CameraBackend::simulated;
-  std::string device_id;                        // Aravis device id; for simulated: the view name
+  std::string device_id;                        // Aravis device id; gentl: the GenTL device id, serial
+                                                // or user-defined name; for simulated: the view name
+  // gentl only: the producer (.cti file); empty: the producers GENICAM_GENTL64_PATH names.
+  std::filesystem::path producer;
   std::map<std::string, std::string> features;  // extra GenICam features, applied verbatim
   Roi roi;
   PixelFormat pixel_format = PixelFormat::Mono16;
