@@ -15,6 +15,7 @@ find_package(cppzmq REQUIRED)  # brings libzmq as its dependency
 pkg_check_modules(gpiod REQUIRED IMPORTED_TARGET libgpiod)
 pkg_check_modules(fftw3f REQUIRED IMPORTED_TARGET fftw3f)
 pkg_check_modules(aravis REQUIRED IMPORTED_TARGET aravis-0.8)
+pkg_check_modules(httplib REQUIRED IMPORTED_TARGET cpp-httplib)  # the dashboard's HTTP server
 if(TOMORIG_BUILD_TESTS)
   find_package(GTest REQUIRED)
 endif()
