@@ -202,7 +202,14 @@ struct DashboardServer::Impl {
           if (first) out = "retry: 1000\n\n";  // the browser reconnects after a second
           first = false;
           const std::vector<DashboardEvent> events = state.wait_events(*cursor, kKeepAlive);
-          if (stopped || state.closed()) return false;
+          if (stopped || state.closed()) {
+            // Tell the page the source has ended, so it stops reconnecting, and end the stream
+            // cleanly (a last empty chunk) rather than cutting it.
+            static constexpr std::string_view kEnd = "event: end\ndata: {}\n\n";
+            sink.write(kEnd.data(), kEnd.size());
+            sink.done();
+            return true;
+          }
           if (events.empty() && out.empty()) out = ": keep-alive\n\n";
           for (const DashboardEvent& e : events) out += fmt::format("event: {}\ndata: {}\n\n", e.name, e.data);
           return sink.write(out.data(), out.size());

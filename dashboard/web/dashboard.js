@@ -324,6 +324,7 @@ function renderInfo() {
   $('snapshot').disabled = !i.snapshots;
   if (!i.snapshots) $('snapshot').title = 'Snapshots are off: start the dashboard with --snapshots FOLDER';
   if (i.mode === 'session') {
+    document.body.classList.add('session');
     $('pause').disabled = true;
     setPill($('connection'), 'green', 'recorded');
   }
@@ -381,7 +382,10 @@ function renderHistory() {
   const charts = [
     ['ppp (frame A)', perCamera((c) => c.ppp[0]), band(targets.ppp)],
     ['particle image diameter d_τ (px)', perCamera((c) => c.diameter_px[0]), band(targets.diameter_px)],
-    ['saturated fraction', perCamera((c) => Math.max(num(c.saturated_fraction[0]) ?? -1, num(c.saturated_fraction[1]) ?? -1)), band(targets.saturated_fraction)],
+    ['saturated fraction (larger of A, B)', perCamera((c) => {
+      const both = c.saturated_fraction.map(num).filter((v) => v !== null);
+      return both.length ? Math.max(...both) : null;
+    }), band(targets.saturated_fraction)],
     ['Δt check displacement (px)', perCamera((c) => c.dt_displacement_px), band(targets.dt_displacement_px)],
     ['drift, largest sub-volume (px)', perCamera((c) => c.drift_px), targets.drift_warn_px ? [0, targets.drift_warn_px] : null],
     ['sheet position (mm)', perSet('position', (r) => r.sheet_position_mm), null],
@@ -406,6 +410,11 @@ function connect() {
     if (!state.info || state.info.mode !== 'session') setPill($('connection'), 'green', 'live');
   };
   events.onerror = () => setPill($('connection'), 'red', 'disconnected, retrying');
+  // The run (or the viewer) ended: what is shown stays, nothing more will come.
+  events.addEventListener('end', () => {
+    events.close();
+    setPill($('connection'), 'amber', 'ended');
+  });
   for (const topic of Object.keys(RENDER)) {
     events.addEventListener(topic, (e) => {
       state[topic] = JSON.parse(e.data);

@@ -106,6 +106,8 @@ test('the dashboard follows a simulated run in Chromium', { timeout: 90_000 }, a
     shown = Number(await page.locator('#set').textContent());
   }
   t.diagnostic(`seconds between updates of the set shown: ${gaps.map((g) => (g / 1000).toFixed(2)).join(' ')}`);
+  const median = gaps.slice().sort((a, b) => a - b)[2];
+  assert.ok(median < 1000, `the set shown changes at least once per second (median gap ${median} ms)`);
 
   // Pause freezes the view while the run goes on; Resume shows the newest set again.
   await page.click('#pause');
@@ -140,4 +142,45 @@ test('the dashboard follows a simulated run in Chromium', { timeout: 90_000 }, a
   await page.waitForSelector('[data-alarm="camera:cam2"].acknowledged', { timeout: 10_000 });
 
   assert.deepEqual(consoleErrors, [], 'no console error');
+
+  // The run ends; its session, opened with `tomorig preview --session`, shows its quick-look
+  // history as time series.
+  const ended = new Promise((resolve) => run.child.on('exit', resolve));
+  run.child.kill('SIGINT');
+  await page.waitForFunction(() => document.getElementById('connection').textContent === 'ended', null,
+    { timeout: 30_000 });
+  await ended;
+  await page.close();
+  const session = join(dir, 's.h5');
+  assert.ok(existsSync(session), 'the stopped run closed its session');
+  const viewer = spawn(binary, ['preview', '--session', session, '--http', '127.0.0.1:0'], { stdio: ['ignore', 'ignore', 'pipe'] });
+  t.after(() => { if (viewer.exitCode === null) viewer.kill('SIGINT'); });
+  let viewerErr = '';
+  const historyUrl = await new Promise((resolve, reject) => {
+    viewer.stderr.on('data', (chunk) => {
+      viewerErr += chunk;
+      const m = viewerErr.match(/dashboard on (http:\/\/\S+)/);
+      if (m) resolve(m[1]);
+    });
+    viewer.on('exit', (code) => reject(new Error(`tomorig preview --session ended (${code}):\n${viewerErr}`)));
+  });
+  const history = await browser.newPage({ viewport: { width: 1400, height: 1600 } });
+  history.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
+  history.on('pageerror', (e) => consoleErrors.push(String(e)));
+  await history.goto(historyUrl);
+  await history.waitForSelector('#history-panel:not(.hidden) .chart canvas', { timeout: 10_000 });
+  assert.match(await history.locator('#history-range').textContent(), /\d+ sets measured/);
+  assert.equal(await history.locator('#history .chart').count(), 9);
+  // The ppp chart has its lines drawn: pixels in the series colours, not only the frame.
+  const drawn = await history.evaluate(() => {
+    const canvas = document.querySelector('#history .chart canvas');
+    const data = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height).data;
+    let coloured = 0;
+    for (let i = 0; i < data.length; i += 4) if (data[i + 2] > 200 && data[i] < 150) ++coloured;  // cam0's blue
+    return coloured;
+  });
+  assert.ok(drawn > 20, `ppp time series drawn (${drawn} blue pixels)`);
+  if (process.env.TOMORIG_SCREENSHOT_HISTORY)
+    await history.screenshot({ path: process.env.TOMORIG_SCREENSHOT_HISTORY, fullPage: true });
+  assert.deepEqual(consoleErrors, [], 'no console error on the history page');
 });
