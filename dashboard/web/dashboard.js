@@ -159,6 +159,7 @@ function renderQuickLook() {
     const tile = tileFor(cam.id);
     if (images.has(cam.id + '/a')) tile.thumb.src = withToken(`/image/${cam.id}/a?set=${q.set}`);
     const s = cam.statistics;
+    tile.thumb.classList.toggle('stale', !s);  // the frame is missing: the picture is an older one
     drawHistogram(tile.histogram, s && s.a ? s.a.histogram : null,
       s && s.a && s.a.saturation ? judgedValue(s.a.saturation.fraction) : null);
     for (const [, key, pick, digits] of FIGURES) {

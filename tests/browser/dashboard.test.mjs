@@ -130,14 +130,13 @@ test('the dashboard follows a simulated run in Chromium', { timeout: 90_000 }, a
   const file = (await page.locator('#action-result').textContent()).replace('snapshot: ', '');
   assert.ok(existsSync(file) && statSync(file).size > 1000, `snapshot ${file}`);
 
-  if (process.env.TOMORIG_SCREENSHOT) await page.screenshot({ path: process.env.TOMORIG_SCREENSHOT, fullPage: true });
-
   // The camera that vanishes: its tile turns red, the others stay as they were, its alarm is acknowledged.
   await page.waitForSelector('[data-camera="cam2"].tile.red', { timeout: 45_000 });
   assert.match(await page.locator('[data-camera="cam2"] .health').textContent(), /disconnected/);
   assert.doesNotMatch(await page.locator('[data-camera="cam0"]').getAttribute('class'), /red/);
   const alarm = page.locator('[data-alarm="camera:cam2"]');
   await alarm.waitFor({ timeout: 10_000 });
+  if (process.env.TOMORIG_SCREENSHOT) await page.screenshot({ path: process.env.TOMORIG_SCREENSHOT, fullPage: true });
   await alarm.locator('button').click();
   await page.waitForSelector('[data-alarm="camera:cam2"].acknowledged', { timeout: 10_000 });
 
