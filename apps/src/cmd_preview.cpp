@@ -47,15 +47,15 @@ struct PreviewArgs {
 
 // --http: serve the dashboard until Ctrl-C, fed live by the streams or by a session file.
 void serve_dashboard(const PreviewArgs& args) {
-  dashboard::DashboardServerOptions server_options = http_server_options(args.http);
+  std::optional<config::RigConfig> rig;
+  if (!args.config_path.empty()) rig = config::load_rig_config(args.config_path);
+  const dashboard::DashboardServerOptions server_options = http_server_options(args.http, rig ? &rig->dashboard : nullptr);
   dashboard::DashboardState state;
   std::optional<dashboard::LiveFeed> feed;
   if (!args.session.empty()) {
     const storage::SessionReader session(args.session);  // before any thread starts (see SessionReader)
     dashboard::show_session(state, session);
   } else {
-    std::optional<config::RigConfig> rig;
-    if (!args.config_path.empty()) rig = config::load_rig_config(args.config_path);
     state.set_info(dashboard::dashboard_info({.mode = "live",
                                               .source = args.from,
                                               .rig = rig ? &*rig : nullptr,

@@ -68,7 +68,7 @@ void run(const RunArgs& args) {
   const std::string preview =
       args.preview_given || args.http_given ? pipeline::preview_endpoint(args.preview) : std::string();
   const std::optional<dashboard::DashboardServerOptions> http =
-      args.http_given ? std::optional(http_server_options(args.http)) : std::nullopt;
+      args.http_given ? std::optional(http_server_options(args.http, &rig.dashboard)) : std::nullopt;
   if (!preview.empty()) options.stages.push_back(pipeline::quicklook_stage_spec(preview, options.stages));
 
   // Builds, configures and arms everything: a bad rig or output fails here, before a file exists.

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "tomorig/config/rig_config.h"
 #include "tomorig/dashboard/dashboard_server.h"
 
 namespace CLI {
@@ -22,8 +23,10 @@ struct HttpChoices {
 
 void add_http_options(CLI::App& cmd, HttpChoices& choices);
 
-// The server's options; a remote address allowed without --http-token gets a generated token
-// (the URL the command prints carries it).
-dashboard::DashboardServerOptions http_server_options(const HttpChoices& choices);
+// The server's options: the options first, then the rig file's [dashboard] (may be null) for
+// the address when --http has no value and for allow_remote. A remote address allowed without
+// --http-token gets a generated token (the URL the command prints carries it).
+dashboard::DashboardServerOptions http_server_options(const HttpChoices& choices,
+                                                      const config::DashboardConfig* rig = nullptr);
 
 }  // namespace tomorig::app

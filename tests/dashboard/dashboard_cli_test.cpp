@@ -137,3 +137,40 @@ TEST_F(DashboardCli, BadUseIsRefusedBeforeAnyFile) {
 
 }  // namespace
 }  // namespace tomorig::testing
+
+namespace tomorig::testing {
+namespace {
+
+// The rig file's [dashboard]: its address serves `--http` without a value; a remote one needs
+// allow_remote; bad keys are named.
+TEST_F(DashboardCli, RigFileSetsTheAddressAndGuardsRemoteOnes) {
+  TempDir dir;
+  const CliResult rig = run_tomorig("config default");
+  ASSERT_EQ(rig.exit_code, 0) << rig.err;
+  const fs::path local = dir.write("local.toml", rig.out + "\n[dashboard]\nhttp = \"127.0.0.1:0\"\n");
+  TomorigProcess run({"run", "--config", local.string(), "--sets", "3", "--status", "none", "--preview",
+                      "ipc://" + (dir / "ql").string(), "--http", "-o", (dir / "a.h5").string()});
+  EXPECT_GT(dashboard_port(run), 0) << run.err();
+  EXPECT_EQ(run.wait(), 0) << run.err();
+
+  const fs::path remote = dir.write("remote.toml", rig.out + "\n[dashboard]\nhttp = \"0.0.0.0:0\"\n");
+  const CliResult refused = run_tomorig("run --config " + shell_quoted(remote.string()) +
+                                        " --sets 2 --status none --http -o " + shell_quoted((dir / "b.h5").string()));
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_NE(refused.err.find("refusing to serve the dashboard on 0.0.0.0:0"), std::string::npos) << refused.err;
+  EXPECT_FALSE(fs::exists(dir / "b.h5"));
+
+  const fs::path bad = dir.write("bad.toml", rig.out + "\n[dashboard]\nhttp = \"somewhere\"\n");
+  const CliResult malformed = run_tomorig("run --config " + shell_quoted(bad.string()) +
+                                          " --sets 2 --status none --http -o " + shell_quoted((dir / "c.h5").string()));
+  EXPECT_EQ(malformed.exit_code, 2);
+  EXPECT_NE(malformed.err.find("[dashboard] http"), std::string::npos) << malformed.err;
+
+  const fs::path unknown = dir.write("unknown.toml", rig.out + "\n[dashboard]\nport = 8080\n");
+  const CliResult check = run_tomorig("config check " + shell_quoted(unknown.string()));
+  EXPECT_EQ(check.exit_code, 2);
+  EXPECT_NE(check.err.find("dashboard.port"), std::string::npos) << check.err;
+}
+
+}  // namespace
+}  // namespace tomorig::testing
