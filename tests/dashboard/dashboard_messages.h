@@ -3,6 +3,7 @@
 // messages"), small enough to write by hand: JSON part plus real PNG parts.
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -22,7 +23,8 @@ inline std::string ramp_png(int width, int height) {
 
 inline nlohmann::json judged(double value, const char* flag) { return {{"value", value}, {"flag", flag}}; }
 
-inline stream::PreviewMessage quicklook_message(std::uint64_t set, double ppp = 0.05) {
+inline stream::PreviewMessage quicklook_message(std::uint64_t set, double ppp = 0.05, int cameras = 1,
+                                                int thumbnail_px = 16) {
   using nlohmann::json;
   json frame = {{"particles", {{"ppp", judged(ppp, "green")}, {"diameter_px", judged(2.4, "green")},
                                {"source_density", judged(0.2, "green")}}},
@@ -34,12 +36,23 @@ inline stream::PreviewMessage quicklook_message(std::uint64_t set, double ppp = 
               {"statistics", {{"a", frame}, {"b", frame}, {"energy_balance", judged(1.0, "green")}}},
               {"dt_check", {{"displacement_px", judged(5.0, "green")}, {"valid_fraction", judged(0.9, "green")},
                             {"windows", json::array({{{"dx", 1.0}}})}}}};
+  json all = json::array(), images = json::array();
+  std::vector<std::string> parts;
+  for (int c = 0; c < cameras; ++c) {
+    const std::string id = "cam" + std::to_string(c);
+    cam["id"] = id;
+    all.push_back(cam);
+    images.push_back({{"name", id + "/a"}, {"kind", "thumbnail"}, {"part", parts.size() + 1}, {"width", thumbnail_px},
+                      {"height", thumbnail_px / 2}});
+    parts.push_back(ramp_png(thumbnail_px, thumbnail_px / 2));
+    images.push_back({{"name", id + "/histogram"}, {"kind", "histogram"}, {"part", parts.size() + 1}, {"width", 5},
+                      {"height", 4}});
+    parts.push_back(ramp_png(5, 4));
+  }
   json j = {{"type", "tomorig.quicklook"}, {"version", 1}, {"time_ns", 1}, {"set", set}, {"trigger_index", set},
-            {"dt_ns", 100000}, {"flag", "green"}, {"cameras", {cam}}, {"preview", nullptr}, {"drift", nullptr},
-            {"counts", {{"analysed", set + 1}}},
-            {"images", {{{"name", "cam0/a"}, {"kind", "thumbnail"}, {"part", 1}, {"width", 16}, {"height", 8}},
-                        {{"name", "cam0/histogram"}, {"kind", "histogram"}, {"part", 2}, {"width", 5}, {"height", 4}}}}};
-  return {j.dump(), {ramp_png(16, 8), ramp_png(5, 4)}};
+            {"dt_ns", 100000}, {"flag", "green"}, {"cameras", all}, {"preview", nullptr}, {"drift", nullptr},
+            {"counts", {{"analysed", set + 1}}}, {"images", images}};
+  return {j.dump(), parts};
 }
 
 inline stream::PreviewMessage preview_message(std::uint64_t set) {

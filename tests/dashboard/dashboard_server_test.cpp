@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <memory>
+#include <thread>
 
 #include <httplib.h>
 #include <nlohmann/json.hpp>
@@ -141,6 +143,51 @@ TEST(DashboardServer, EventStreamDeliversWhatTheQuickLookPublishes) {
   EXPECT_EQ(feed.stats().rejected, 0u);
 }
 
+// Issue 17: six cameras at 10 Hz with several pages watching. Every page sees (nearly) every set
+// soon after it is published, and the dashboard's subscriber keeps up: the publisher, which
+// never waits, has to drop nothing for it.
+TEST(DashboardServer, SixCamerasAtTenHertzReachEveryPage) {
+  TempDir dir;
+  const std::string endpoint = "ipc://" + (dir / "ql").string();
+  zmq::context_t context(1);
+  stream::PreviewPublisher publisher(context, stream::preview_socket_options(endpoint));
+  dashboard::DashboardState state;
+  dashboard::LiveFeed feed(state, {.preview_endpoint = endpoint});
+  dashboard::DashboardServer server(state, loopback_any_port());
+  std::vector<std::unique_ptr<EventStream>> pages;
+  for (int i = 0; i < 3; ++i) pages.push_back(std::make_unique<EventStream>(server.port()));
+  // Until the subscription is in place (PUB/SUB drops what comes before it).
+  bool arrived = false;
+  for (int attempt = 0; attempt < 100 && !arrived; ++attempt) {
+    publisher.publish(testing::quicklook_message(0, 0.05, 6, 160));
+    arrived = pages[0]->wait_for("\"set\":0,", 100ms);
+  }
+  ASSERT_TRUE(arrived);
+  const std::uint64_t dropped_before = publisher.stats().sets_dropped;
+
+  constexpr int kSets = 30;  // 3 s at the rig's 10 Hz
+  auto due = std::chrono::steady_clock::now();
+  for (int set = 1; set <= kSets; ++set) {
+    publisher.publish(testing::quicklook_message(static_cast<std::uint64_t>(set), 0.05, 6, 160));
+    due += 100ms;
+    std::this_thread::sleep_until(due);  // the rig's pace, not a wait for a result
+  }
+  for (auto& page : pages) {
+    EXPECT_TRUE(page->wait_for("\"set\":" + std::to_string(kSets) + ",", 1s)) << "the last set within 1 s";
+    int seen = 0;
+    for (int set = 1; set <= kSets; ++set)
+      seen += page->text().find("\"set\":" + std::to_string(set) + ",") != std::string::npos;
+    EXPECT_GE(seen, kSets * 9 / 10) << "a page keeping up gets (nearly) every set";
+  }
+  EXPECT_EQ(publisher.stats().sets_dropped, dropped_before) << "the dashboard never made the publisher drop";
+  EXPECT_EQ(feed.stats().rejected, 0u);
+  httplib::Client client("127.0.0.1", server.port());
+  const auto thumb = client.Get("/image/cam5/a");
+  ASSERT_TRUE(thumb);
+  EXPECT_EQ(storage::decode_png(thumb->body).width(), 160);
+  server.stop();  // the pages' streams end at once (an end event) instead of at their next keep-alive
+}
+
 TEST(DashboardServer, TokenIsCheckedOnEveryRequest) {
   dashboard::DashboardState state;
   state.take_message(testing::quicklook_message(1));
@@ -271,6 +318,8 @@ TEST(DashboardServer, AcknowledgingAnAlarmReachesEveryPage) {
     EXPECT_NE(bad->body.find("error"), std::string::npos) << body;
   }
   EXPECT_EQ(state.acknowledged(), std::vector<std::string>{"drift:cam1"});
+  server.stop();
+  EXPECT_TRUE(events.wait_for("event: end", 5s)) << "the page is told the source ended";
 }
 
 TEST(DashboardServer, SnapshotWritesTheNewestSetAsPngOnce) {
