@@ -15,6 +15,7 @@ find_package(cppzmq REQUIRED)  # brings libzmq as its dependency
 pkg_check_modules(gpiod REQUIRED IMPORTED_TARGET libgpiod)
 pkg_check_modules(fftw3f REQUIRED IMPORTED_TARGET fftw3f)
 pkg_check_modules(aravis REQUIRED IMPORTED_TARGET aravis-0.8)
+pkg_check_modules(httplib REQUIRED IMPORTED_TARGET cpp-httplib)  # the dashboard's HTTP server
 # MPI (OpenMPI, C API) for `mpirun tomorig process`. Listed in scripts/apt-packages.txt, so it is
 # there on a machine set up by scripts/setup.sh; a build without it still works as one process and
 # refuses to run under mpirun with a message saying so.

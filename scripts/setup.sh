@@ -39,6 +39,20 @@ install_missing_packages() {
   $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 }
 
+# The dashboard's browser test (tests/browser/) runs Playwright from npm against Debian's
+# Chromium: `npm ci` installs exactly the versions in its package-lock.json, again only when
+# the lock file changed since.
+install_browser_test_packages() {
+  local dir="$root/tests/browser"
+  if ! command -v npm >/dev/null; then
+    echo "setup: npm not found: install Node.js 20 with npm for the dashboard's browser test" >&2; exit 1
+  fi
+  if [[ ! -d "$dir/node_modules/playwright-core" || "$dir/package-lock.json" -nt "$dir/node_modules/.package-lock.json" ]]; then
+    echo "setup: installing the browser test's npm packages (tests/browser/package-lock.json)"
+    (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error)
+  fi
+}
+
 build() {
   echo "setup: configuring and building in $build_dir (Release)"
   cmake -S "$root" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
@@ -46,6 +60,7 @@ build() {
 }
 
 install_missing_packages
+if [[ $mode == test ]]; then install_browser_test_packages; fi
 build
 
 case "$mode" in

@@ -1,6 +1,8 @@
 // tomorig preview: watches the quick-look results a running rig (tomorig run --preview) or a
 // replay (tomorig replay --preview) publishes. A terminal view refreshed in place, plain lines
-// when stdout is not a terminal, one JSON line per set with --json, snapshots with --png.
+// when stdout is not a terminal, one JSON line per set with --json, snapshots with --png; with
+// --http the operator's dashboard in a browser instead (docs/dashboard.md), live or, with
+// --session, a recorded run's quick-look history.
 #include <unistd.h>
 
 #include <chrono>
@@ -13,7 +15,13 @@
 #include <zmq.hpp>
 
 #include "commands.h"
+#include "http_options.h"
+#include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
+#include "tomorig/dashboard/dashboard_info.h"
+#include "tomorig/dashboard/live_feed.h"
+#include "tomorig/dashboard/session_view.h"
+#include "tomorig/storage/session_file.h"
 #include "tomorig/pipeline/quicklook_view.h"
 #include "tomorig/rig/stop_signal.h"
 #include "tomorig/stream/preview.h"
@@ -30,9 +38,51 @@ struct PreviewArgs {
   std::string png;
   std::uint64_t count = 0;  // stop after this many sets; 0: until Ctrl-C
   double timeout_s = 0;     // give up after this long without a message; 0: wait for ever
+  HttpChoices http;
+  bool http_given = false;
+  std::string status;      // --status: the run's status stream, for the dashboard
+  std::string config_path; // --config: the rig, for the dashboard's trigger plan and targets
+  std::string session;     // --session: a recorded run's history on the dashboard
 };
 
+// --http: serve the dashboard until Ctrl-C, fed live by the streams or by a session file.
+void serve_dashboard(const PreviewArgs& args) {
+  std::optional<config::RigConfig> rig;
+  if (!args.config_path.empty()) rig = config::load_rig_config(args.config_path);
+  const dashboard::DashboardServerOptions server_options = http_server_options(args.http, rig ? &rig->dashboard : nullptr);
+  dashboard::DashboardState state;
+  std::optional<dashboard::LiveFeed> feed;
+  if (!args.session.empty()) {
+    const storage::SessionReader session(args.session);  // before any thread starts (see SessionReader)
+    dashboard::show_session(state, session);
+  } else {
+    state.set_info(dashboard::dashboard_info({.mode = "live",
+                                              .source = args.from,
+                                              .rig = rig ? &*rig : nullptr,
+                                              .snapshots = !server_options.snapshot_folder.empty()}));
+  }
+  const rig::StopSignalGuard stop;
+  if (args.session.empty())
+    feed.emplace(state, dashboard::LiveFeedOptions{
+                            .preview_endpoint = args.from,
+                            .status_endpoint = args.status,
+                            .notice = [](const std::string& text) { fmt::print(stderr, "preview: {}\n", text); }});
+  dashboard::DashboardServer server(state, server_options);
+  fmt::print(stderr, "preview: dashboard on {} showing {} (Ctrl-C ends)\n", server.url(),
+             args.session.empty() ? args.from : args.session);
+  std::fflush(stderr);
+  while (!stop.wait_for(std::chrono::seconds(1))) {
+  }
+  server.stop();
+  fmt::print(stderr, "preview: dashboard stopped by {} after {} quick-look messages\n", stop.signal_name(),
+             state.messages());
+}
+
 void watch(PreviewArgs args) {
+  if (args.http_given) return serve_dashboard(args);
+  if (!args.session.empty())
+    throw bad_input("--session shows a recorded run on the dashboard and needs --http (tomorig inspect prints the "
+                    "history as text)");
   if (!(args.timeout_s >= 0)) throw bad_input(fmt::format("--timeout {:g} is invalid: it must be >= 0 seconds", args.timeout_s));
   if (!(args.view.png_interval_s >= 0))
     throw bad_input(fmt::format("--png-interval {:g} is invalid: it must be >= 0 seconds", args.view.png_interval_s));
@@ -92,7 +142,17 @@ void add_preview_command(CLI::App& root) {
   cmd->add_option("--count", args->count, "Stop after this many sets (default: until Ctrl-C)");
   cmd->add_option("--timeout", args->timeout_s,
                   "Give up (exit 1) after this many seconds without a message (default: wait for ever)");
-  cmd->callback([args] { watch(*args); });
+  add_http_options(*cmd, args->http);
+  cmd->add_option("--status", args->status,
+                  "With --http: also show the run's status stream (tomorig run --status), e.g. tcp://127.0.0.1:5556");
+  cmd->add_option("--config", args->config_path,
+                  "With --http: the rig file, for the trigger plan and the quick-look targets on the dashboard");
+  cmd->add_option("--session", args->session,
+                  "With --http: show this session's stored quick-look history instead of a live stream");
+  cmd->callback([args, cmd] {
+    args->http_given = args->http.given(*cmd);
+    watch(*args);
+  });
 }
 
 }  // namespace tomorig::app

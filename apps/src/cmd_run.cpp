@@ -3,14 +3,18 @@
 #include <ctime>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <fmt/core.h>
 
 #include "commands.h"
+#include "http_options.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
+#include "tomorig/dashboard/dashboard_info.h"
+#include "tomorig/dashboard/live_feed.h"
 #include "tomorig/pipeline/quicklook_settings.h"
 #include "tomorig/stream/preview.h"
 #include "tomorig/rig/rig_run_options.h"
@@ -29,6 +33,16 @@ struct RunArgs {
   std::vector<std::string> stages;
   std::vector<std::string> preview;  // --preview [ENDPOINT]: given with or without a value
   bool preview_given = false;
+  HttpChoices http;  // --http: the dashboard, fed by the run's quick-look and status streams
+  bool http_given = false;
+};
+
+// The dashboard of a run: a subscriber to the run's own quick-look and status streams, as a
+// separate `tomorig preview --http` would be, so it never holds the recorder up.
+struct RunDashboard {
+  dashboard::DashboardState state;
+  std::optional<dashboard::LiveFeed> feed;
+  std::optional<dashboard::DashboardServer> server;
 };
 
 std::filesystem::path default_output_path() {
@@ -50,7 +64,11 @@ void run(const RunArgs& args) {
   options.status_endpoint = args.rig.status;
   options.notice = [](const std::string& text) { fmt::print(stderr, "run: {}\n", text); };
   for (const std::string& text : args.stages) options.stages.push_back(pipeline::parse_stage_spec(text));
-  const std::string preview = args.preview_given ? pipeline::preview_endpoint(args.preview) : std::string();
+  // The dashboard shows the quick-look: --http turns it on at the default endpoint if --preview did not.
+  const std::string preview =
+      args.preview_given || args.http_given ? pipeline::preview_endpoint(args.preview) : std::string();
+  const std::optional<dashboard::DashboardServerOptions> http =
+      args.http_given ? std::optional(http_server_options(args.http, &rig.dashboard)) : std::nullopt;
   if (!preview.empty()) options.stages.push_back(pipeline::quicklook_stage_spec(preview, options.stages));
 
   // Builds, configures and arms everything: a bad rig or output fails here, before a file exists.
@@ -62,6 +80,18 @@ void run(const RunArgs& args) {
   std::fflush(stdout);
   if (!runner.status_endpoint().empty()) fmt::print(stderr, "run: status JSON on {}\n", runner.status_endpoint());
   if (!preview.empty()) fmt::print(stderr, "run: quick-look results on {} (watch: tomorig preview --from {})\n", preview, preview);
+  RunDashboard board;
+  if (http) {
+    board.state.set_info(dashboard::dashboard_info(
+        {.mode = "live", .source = rig.name, .rig = &rig, .snapshots = !http->snapshot_folder.empty()}));
+    board.feed.emplace(board.state, dashboard::LiveFeedOptions{
+                                        .preview_endpoint = preview,
+                                        .status_endpoint = runner.status_endpoint(),
+                                        .notice = [](const std::string& text) { fmt::print(stderr, "run: {}\n", text); }});
+    board.server.emplace(board.state, *http);
+    fmt::print(stderr, "run: dashboard on {}\n", board.server->url());
+  }
+  std::fflush(stderr);
 
   // Ctrl-C ends the run between sets: acquisition stops, the sets already taken are recorded,
   // and the file is closed complete and valid. A second Ctrl-C quits at once.
@@ -115,8 +145,10 @@ void add_run_command(CLI::App& root) {
                               "sets and publish it here for 'tomorig preview'; without a value {}",
                               stream::kDefaultPreviewEndpoint))
       ->expected(0, 1);
+  add_http_options(*cmd, args->http);
   cmd->callback([args, cmd] {
     args->preview_given = cmd->count("--preview") > 0;
+    args->http_given = args->http.given(*cmd);
     run(*args);
   });
 }

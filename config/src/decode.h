@@ -22,6 +22,7 @@ void decode_grid(TableReader& root, GridConfig& grid);                          
 void decode_processing(TableReader& root, ProcessingConfig& processing);         // [processing]
 void decode_simulation(TableReader& root, std::optional<SimulationConfig>& sim);  // [simulation]
 void decode_quicklook(TableReader& root, QuickLookConfig& quicklook);            // [quicklook] and sub-tables
+void decode_dashboard(TableReader& root, DashboardConfig& dashboard);           // [dashboard]
 
 // Parts of [trigger], called by decode_trigger() in this order.
 void decode_camera_timing(TableReader& trigger, CameraTimingConfig& camera);  // [trigger.camera]

@@ -17,6 +17,7 @@ RigConfig decode_rig(const toml::table& root_table, std::vector<ConfigIssue>& is
   decode_processing(root, rig.processing);
   decode_simulation(root, rig.simulation);
   decode_quicklook(root, rig.quicklook);
+  decode_dashboard(root, rig.dashboard);
   root.report_unknown_keys();
   return rig;
 }

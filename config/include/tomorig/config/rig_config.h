@@ -157,6 +157,12 @@ struct QuickLookConfig {
   } preview;
 };
 
+// [dashboard]: the operator's dashboard of `tomorig run --http` (docs/dashboard.md).
+struct DashboardConfig {
+  std::string http;           // HOST:PORT for --http given without a value; empty: the dashboard's default
+  bool allow_remote = false;  // a non-loopback address is allowed (then every request needs a token)
+};
+
 struct RigConfig {
   std::string name = "tomorig rig";
   std::vector<CameraConfig> cameras;
@@ -166,6 +172,7 @@ struct RigConfig {
   ProcessingConfig processing;
   std::optional<SimulationConfig> simulation;
   QuickLookConfig quicklook;
+  DashboardConfig dashboard;
   std::string source_text;  // the TOML text it was parsed from
 };
 
