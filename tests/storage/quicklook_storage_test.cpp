@@ -38,6 +38,8 @@ std::vector<unsigned long long> dims(const fs::path& file, const char* path) {
   H5Fclose(f);
   return {out.begin(), out.end()};
 }
+// Reads a string-list attribute the way an outside tool would, whether its strings are stored
+// fixed-length (format-2 session files) or variable-length.
 std::vector<std::string> string_list_attribute(const fs::path& file, const char* path, const char* name) {
   const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   const hid_t d = H5Dopen2(f, path, H5P_DEFAULT);
@@ -45,14 +47,28 @@ std::vector<std::string> string_list_attribute(const fs::path& file, const char*
   const hid_t space = H5Aget_space(a);
   hsize_t n = 0;
   H5Sget_simple_extent_dims(space, &n, nullptr);
-  const hid_t type = H5Tcopy(H5T_C_S1);
-  H5Tset_size(type, H5T_VARIABLE);
-  H5Tset_cset(type, H5T_CSET_UTF8);
-  std::vector<char*> raw(n);
-  H5Aread(a, type, raw.data());
-  std::vector<std::string> out(raw.begin(), raw.end());
-  H5Dvlen_reclaim(type, space, H5P_DEFAULT, raw.data());
-  H5Tclose(type);
+  const hid_t stored = H5Aget_type(a);
+  std::vector<std::string> out;
+  if (H5Tis_variable_str(stored) > 0) {
+    const hid_t type = H5Tcopy(H5T_C_S1);
+    H5Tset_size(type, H5T_VARIABLE);
+    H5Tset_cset(type, H5T_CSET_UTF8);
+    std::vector<char*> raw(n);
+    H5Aread(a, type, raw.data());
+    for (char* p : raw) out.emplace_back(p != nullptr ? p : "");
+    H5Dvlen_reclaim(type, space, H5P_DEFAULT, raw.data());
+    H5Tclose(type);
+  } else {
+    const std::size_t width = H5Tget_size(stored);
+    std::vector<char> raw(n * width);
+    H5Aread(a, stored, raw.data());
+    for (hsize_t i = 0; i < n; ++i) {
+      std::string value(raw.data() + i * width, width);
+      value.erase(value.find_last_not_of(std::string("\0 ", 2)) + 1);
+      out.push_back(value);
+    }
+  }
+  H5Tclose(stored);
   H5Sclose(space);
   H5Aclose(a);
   H5Dclose(d);
