@@ -109,6 +109,7 @@ struct QuickLook::Work {
   detail::TileScratch tile_scratch;
   std::vector<std::int32_t> thresholds;
   std::vector<std::uint32_t> maxima;
+  std::vector<std::uint16_t> maxima_rows;
   std::vector<float> scratch;
 
   void prepare(const Image& image, int tile) {
@@ -118,6 +119,7 @@ struct QuickLook::Work {
     tiles.resize(n);
     thresholds.resize(n);
     maxima.resize(n);
+    maxima_rows.resize(3 * static_cast<std::size_t>(image.width()));
     scratch.reserve(n);
     const std::size_t per_row = static_cast<std::size_t>(tile / detail::kSampleStep + 1);
     tile_scratch.sample.resize(per_row * per_row);
@@ -224,7 +226,7 @@ void QuickLook::analyse(const Image& image, FrameStatistics& out) {
   out.background_p95 = percentile_of(w.scratch, 0.95);
 
   // ---- Pass 2: particle images as local maxima.
-  const std::uint64_t maxima = detail::count_maxima(image, g, w.thresholds, w.maxima);
+  const std::uint64_t maxima = detail::count_maxima(image, g, w.thresholds, w.maxima, w.maxima_rows);
   const double interior = static_cast<double>(image.width() - 2) * (image.height() - 2);
   out.maxima_per_pixel = static_cast<double>(maxima) / interior;
 

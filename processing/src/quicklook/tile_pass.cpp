@@ -179,45 +179,78 @@ void accumulate_all(const Image& image, const TileGrid& g, int full_scale, std::
                          scratch);
 }
 
+// Horizontal maximum of each pixel and its left and right neighbours, for x in [1, w - 1).
 template <typename T>
-std::uint32_t maxima_in_tile(const Image& image, const TileGrid& g, int i, int j, std::int32_t threshold) {
-  constexpr std::int32_t top = std::numeric_limits<T>::max();
-  if (threshold >= top) return 0;  // nothing can exceed it
-  const int x0 = std::max(g.x0(i), 1), x1 = std::min(g.x1(i), g.width - 1);
-  const int y0 = std::max(g.y0(j), 1), y1 = std::min(g.y1(j), g.height - 1);
-  // Every pixel exceeds a negative threshold, so 0 serves with >= instead of >: compare in T.
-  const bool any = threshold < 0;
-  const T floor = any ? T{0} : static_cast<T>(threshold + 1);  // v > threshold  <=>  v >= floor
-  std::uint32_t count = 0;
-  for (int y = y0; y < y1; ++y) {
-    const T* rm = image.row<T>(y - 1);
-    const T* r0 = image.row<T>(y);
-    const T* rp = image.row<T>(y + 1);
-    std::uint32_t c = 0;
-#pragma omp simd reduction(+ : c)
-    for (int x = x0; x < x1; ++x) {
-      const T v = r0[x];
-      // Strictly above the neighbours before it in raster order, at least equal to those after.
-      const bool peak = (v >= floor) & (v > rm[x - 1]) & (v > rm[x]) & (v > rm[x + 1]) & (v > r0[x - 1]) &
-                        (v >= r0[x + 1]) & (v >= rp[x - 1]) & (v >= rp[x]) & (v >= rp[x + 1]);
-      c += peak ? 1u : 0u;
-    }
-    count += c;
+[[gnu::always_inline]] inline void row_max3(const T* r, T* out, int w) {
+#pragma omp simd
+  for (int x = 1; x < w - 1; ++x) {
+    const T a = r[x - 1] > r[x] ? r[x - 1] : r[x];
+    out[x] = a > r[x + 1] ? a : r[x + 1];
   }
-  return count;
 }
 
+// Local maxima of row r0 over x in [x0, x1): `above` and `below` are the 3-px horizontal maxima
+// of the rows above and below. A peak is strictly above the four neighbours before it in raster
+// order (the row above and its left neighbour) and at least equal to the four after it.
 template <typename T>
-std::uint64_t count_all(const Image& image, const TileGrid& g, const std::vector<std::int32_t>& thresholds,
-                        std::vector<std::uint32_t>& per_tile) {
+[[gnu::always_inline]] inline std::uint32_t row_peaks(const T* r0, const T* above, const T* below, T floor, int x0,
+                                                       int x1) {
+  std::uint32_t c = 0;
+#pragma omp simd reduction(+ : c)
+  for (int x = x0; x < x1; ++x) {
+    const T v = r0[x];
+    const T before = above[x] > r0[x - 1] ? above[x] : r0[x - 1];
+    const T after = below[x] > r0[x + 1] ? below[x] : r0[x + 1];
+    c += static_cast<std::uint32_t>((v >= floor) & (v > before) & (v >= after));
+  }
+  return c;
+}
+
+// The whole frame row by row (rows stream through the cache once), each row's tiles in turn;
+// the horizontal 3-px maxima of three consecutive rows are kept in a ring, so every pixel is
+// compared with two maxima and two neighbours instead of eight neighbours.
+template <typename T>
+[[gnu::always_inline]] inline std::uint64_t count_all(const Image& image, const TileGrid& g,
+                                                      const std::vector<std::int32_t>& thresholds,
+                                                      std::vector<std::uint32_t>& per_tile, T* ring) {
+  constexpr std::int32_t top = std::numeric_limits<T>::max();
+  std::fill(per_tile.begin(), per_tile.end(), 0u);
+  const int w = g.width;
+  const auto ring_row = [&](int y) { return ring + static_cast<std::ptrdiff_t>(y % 3) * w; };
+  row_max3<T>(image.row<T>(0), ring_row(0), w);
+  row_max3<T>(image.row<T>(1), ring_row(1), w);
   std::uint64_t total = 0;
-  for (int j = 0; j < g.ny; ++j)
+  for (int y = 1; y + 1 < g.height; ++y) {
+    row_max3<T>(image.row<T>(y + 1), ring_row(y + 1), w);
+    const T* r0 = image.row<T>(y);
+    const T* above = ring_row(y - 1);
+    const T* below = ring_row(y + 1);
+    const int j = y / g.tile < g.ny ? y / g.tile : g.ny - 1;
     for (int i = 0; i < g.nx; ++i) {
       const auto n = static_cast<std::size_t>(i + g.nx * j);
-      per_tile[n] = maxima_in_tile<T>(image, g, i, j, thresholds[n]);
-      total += per_tile[n];
+      const std::int32_t threshold = thresholds[n];
+      if (threshold >= top) continue;  // nothing can exceed it
+      // v > threshold  <=>  v >= threshold + 1; a negative threshold lets every value pass.
+      const T floor = threshold < 0 ? T{0} : static_cast<T>(threshold + 1);
+      const int x0 = std::max(g.x0(i), 1), x1 = std::min(g.x1(i), w - 1);
+      const std::uint32_t c = row_peaks<T>(r0, above, below, floor, x0, x1);
+      per_tile[n] += c;
+      total += c;
     }
+  }
   return total;
+}
+
+[[gnu::target_clones("arch=x86-64-v3", "default")]] std::uint64_t count_all_u16(
+    const Image& image, const TileGrid& g, const std::vector<std::int32_t>& thresholds,
+    std::vector<std::uint32_t>& per_tile, std::uint16_t* ring) {
+  return count_all<std::uint16_t>(image, g, thresholds, per_tile, ring);
+}
+
+[[gnu::target_clones("arch=x86-64-v3", "default")]] std::uint64_t count_all_u8(
+    const Image& image, const TileGrid& g, const std::vector<std::int32_t>& thresholds,
+    std::vector<std::uint32_t>& per_tile, std::uint8_t* ring) {
+  return count_all<std::uint8_t>(image, g, thresholds, per_tile, ring);
 }
 
 }  // namespace
@@ -249,9 +282,11 @@ void accumulate(const Image& image, const TileGrid& grid, int full_scale, std::v
 }
 
 std::uint64_t count_maxima(const Image& image, const TileGrid& grid, const std::vector<std::int32_t>& thresholds,
-                           std::vector<std::uint32_t>& per_tile) {
-  if (image.type() == SampleType::u8) return count_all<std::uint8_t>(image, grid, thresholds, per_tile);
-  return count_all<std::uint16_t>(image, grid, thresholds, per_tile);
+                           std::vector<std::uint32_t>& per_tile, std::vector<std::uint16_t>& ring) {
+  ring.resize(3 * static_cast<std::size_t>(grid.width));  // no allocation once sized
+  if (image.type() == SampleType::u8)
+    return count_all_u8(image, grid, thresholds, per_tile, reinterpret_cast<std::uint8_t*>(ring.data()));
+  return count_all_u16(image, grid, thresholds, per_tile, ring.data());
 }
 
 }  // namespace tomorig::quicklook::detail

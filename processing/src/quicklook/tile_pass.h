@@ -78,8 +78,9 @@ std::span<const std::uint32_t> histogram_halves(std::vector<std::uint32_t>& hist
 // Pass 2. Counts pixels (with a full 3 x 3 neighbourhood) that exceed their tile's threshold
 // (integer counts: a pixel counts if value > threshold) and are the maximum of their 3 x 3
 // neighbourhood; of equal neighbours the first in raster order wins, so a plateau counts
-// once. Returns the total; `per_tile` (grid.count() entries) receives the tile counts.
+// once. Returns the total; `per_tile` (grid.count() entries) receives the tile counts. `ring`
+// is scratch (three rows of horizontal maxima), sized on first use.
 std::uint64_t count_maxima(const Image& image, const TileGrid& grid, const std::vector<std::int32_t>& thresholds,
-                           std::vector<std::uint32_t>& per_tile);
+                           std::vector<std::uint32_t>& per_tile, std::vector<std::uint16_t>& ring);
 
 }  // namespace tomorig::quicklook::detail
