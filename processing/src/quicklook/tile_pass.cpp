@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "histogram_stats.h"
@@ -9,26 +10,13 @@
 namespace tomorig::quicklook::detail {
 namespace {
 
-// Sum over x in [x0, x1) of a[x] * b[x + shift], and of b[x + shift]. Float partial sums over
-// one tile row: at most a few hundred terms.
-void row_products(const float* a, const float* b, int x0, int x1, int shift, float& products, float& sum_b) {
-  float p = 0, s = 0;
-#pragma omp simd reduction(+ : p, s)
-  for (int x = x0; x < x1; ++x) {
-    p += a[x] * b[x + shift];
-    s += b[x + shift];
-  }
-  products = p;
-  sum_b = s;
-}
-
 // The tile's background level and noise from its own histogram (every other pixel of every other
 // row: 1024 of a 64 px tile): a window of kTileBins bins placed by the sampled 5th percentile,
 // the bins (a power of two counts wide) narrow enough that the sampled 5th to 50th percentiles
 // span 16 to 32 of them; half-sample mode and lower-half noise as for
 // the whole frame (histogram_stats.h).
 template <typename T>
-void tile_background(const Image& image, int x0, int x1, int y0, int y1, std::size_t samples, TileSums& t,
+void tile_background(const Image& image, int x0, int x1, int y0, int y1, std::size_t samples, TileLevel& t,
                      TileScratch& scratch) {
   std::vector<std::uint16_t>& sample = scratch.sample;
   const auto end = sample.begin() + static_cast<std::ptrdiff_t>(samples);
@@ -61,122 +49,244 @@ void tile_background(const Image& image, int x0, int x1, int y0, int y1, std::si
   t.noise = lower_half_sigma(bins, mode) * width;
 }
 
+// One tile of scan_tiles(): histogram, saturated count, background.
 template <typename T>
-void accumulate_tile(const Image& image, const TileGrid& g, int i, int j, int full_scale, std::uint32_t* histogram,
-                     TileSums& t, TileScratch& scratch) {
+[[gnu::always_inline]] inline void scan_tile(const Image& image, const TileGrid& g, int i, int j, int full_scale,
+                                             std::uint32_t* histogram, TileLevel& t, TileScratch& scratch) {
   const int x0 = g.x0(i), x1 = g.x1(i), y0 = g.y0(j), y1 = g.y1(j);
-  const int w = x1 - x0;
-  t = TileSums{};
-  const float offset = static_cast<float>(image.row<T>(y0)[x0]);
-  t.offset = offset;
-
-  // The tile and a 1 px border (for Sobel) as floats minus the offset, converted once for all
-  // the sums below. Integer counts up to 65535 are exact in float.
-  const int bx0 = std::max(x0 - 1, 0), bx1 = std::min(x1 + 1, g.width);
-  const int by0 = std::max(y0 - 1, 0), by1 = std::min(y1 + 1, g.height);
-  const int stride = bx1 - bx0;
-  float* buffer = scratch.tile.data();
-  for (int y = by0; y < by1; ++y) {
-    const T* src = image.row<T>(y);
-    float* dst = buffer + static_cast<std::ptrdiff_t>(y - by0) * stride - bx0;
-#pragma omp simd
-    for (int x = bx0; x < bx1; ++x) dst[x] = static_cast<float>(src[x]) - offset;
-  }
-  // Row y of the buffer, indexed by image column.
-  const auto row = [&](int y) { return buffer + static_cast<std::ptrdiff_t>(y - by0) * stride - bx0; };
-  const float saturation = static_cast<float>(full_scale) - offset;
-  // Sobel needs the 3 x 3 neighbourhood inside the image (it may reach into other tiles).
-  const int sx0 = std::max(x0, 1), sx1 = std::min(x1, g.width - 1);
-
-  std::vector<std::uint16_t>& sample = scratch.sample;
+  t = TileLevel{};
+  t.pixels = static_cast<double>(x1 - x0) * (y1 - y0);
+  const T saturation = static_cast<T>(std::min<int>(full_scale, std::numeric_limits<T>::max()));
+  std::uint16_t* sample = scratch.sample.data();
   std::size_t samples = 0;
   std::uint32_t* odd = histogram + kHistogramStride;
+  std::uint32_t saturated = 0;
   for (int y = y0; y < y1; ++y) {
-    const float* r0 = row(y);
-
-    float s = 0, ss = 0;
-    int saturated = 0;
-#pragma omp simd reduction(+ : s, ss, saturated)
-    for (int x = x0; x < x1; ++x) {
-      const float d = r0[x];
-      s += d;
-      ss += d * d;
-      saturated += d >= saturation ? 1 : 0;
-    }
-    t.n += w;
-    t.sum += s;
-    t.sumsq += ss;
-    t.saturated += saturated;
-
+    const T* raw = image.row<T>(y);
+    std::uint32_t s = 0;
+#pragma omp simd reduction(+ : s)
+    for (int x = x0; x < x1; ++x) s += raw[x] >= saturation ? 1u : 0u;
+    saturated += s;
     // Two histograms for even and odd columns: neighbouring pixels often share a value, and
     // one counter would make every increment wait for the previous one.
-    const T* raw = image.row<T>(y);
     int x = x0;
     for (; x + 1 < x1; x += 2) {
       ++histogram[raw[x]];
       ++odd[raw[x + 1]];
     }
     if (x < x1) ++histogram[raw[x]];
+    if ((y - y0) % kSampleStep == kSampleStep / 2)
+      for (int xs = x0 + kSampleStep / 2; xs < x1; xs += kSampleStep) sample[samples++] = raw[xs];
+  }
+  t.saturated = saturated;
+  if (samples == 0) sample[samples++] = image.row<T>(y0)[x0];  // a sliver of a tile
+  tile_background<T>(image, x0, x1, y0, y1, samples, t, scratch);
+}
 
+template <typename T>
+[[gnu::always_inline]] inline void scan_all(const Image& image, const TileGrid& g, int full_scale,
+                                            std::uint32_t* histogram, TileLevel* tiles, TileScratch& scratch) {
+  // Tile rows outer, so a band of tile image rows stays in cache while its tiles are done.
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) scan_tile<T>(image, g, i, j, full_scale, histogram, tiles[i + g.nx * j], scratch);
+}
+
+[[gnu::target_clones("arch=x86-64-v3", "default")]] void scan_all_u16(const Image& image, const TileGrid& g,
+                                                                      int full_scale, std::uint32_t* histogram,
+                                                                      TileLevel* tiles, TileScratch& scratch) {
+  scan_all<std::uint16_t>(image, g, full_scale, histogram, tiles, scratch);
+}
+
+[[gnu::target_clones("arch=x86-64-v3", "default")]] void scan_all_u8(const Image& image, const TileGrid& g,
+                                                                     int full_scale, std::uint32_t* histogram,
+                                                                     TileLevel* tiles, TileScratch& scratch) {
+  scan_all<std::uint8_t>(image, g, full_scale, histogram, tiles, scratch);
+}
+
+// Eight floats in a vector register (AVX in the x86-64-v3 clones, two SSE halves otherwise).
+// Explicit vectors, not `omp simd` reductions: with six sums GCC kept a scalar loop. They are
+// only passed between inlined functions of this file, so the ABI note GCC gives for 32-byte
+// vectors without AVX does not apply.
+#pragma GCC diagnostic ignored "-Wpsabi"
+using Float8 = float __attribute__((vector_size(32)));
+
+[[gnu::always_inline]] inline Float8 load8(const float* p) {
+  Float8 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+[[gnu::always_inline]] inline float sum8(Float8 v) {
+  return ((v[0] + v[1]) + (v[2] + v[3])) + ((v[4] + v[5]) + (v[6] + v[7]));
+}
+
+struct RowSums {
+  float s, ss, px1, px2, py1, py2;
+};
+
+// Over x in [x0, x1) of row r0 (r1, r2: the next two rows): sum, sum of squares, and the
+// products with the pixel 1 and 2 columns on and 1 and 2 rows down. Reads r0 up to x1 + 1.
+[[gnu::always_inline]] inline RowSums row_sums_and_lags(const float* r0, const float* r1, const float* r2, int x0,
+                                                       int x1) {
+  Float8 s{}, ss{}, px1{}, px2{}, py1{}, py2{};
+  int x = x0;
+  for (; x + 8 <= x1; x += 8) {
+    const Float8 d = load8(r0 + x);
+    s += d;
+    ss += d * d;
+    px1 += d * load8(r0 + x + 1);
+    px2 += d * load8(r0 + x + 2);
+    py1 += d * load8(r1 + x);
+    py2 += d * load8(r2 + x);
+  }
+  RowSums out{sum8(s), sum8(ss), sum8(px1), sum8(px2), sum8(py1), sum8(py2)};
+  for (; x < x1; ++x) {
+    const float d = r0[x];
+    out.s += d;
+    out.ss += d * d;
+    out.px1 += d * r0[x + 1];
+    out.px2 += d * r0[x + 2];
+    out.py1 += d * r1[x];
+    out.py2 += d * r2[x];
+  }
+  return out;
+}
+
+// Sobel gradient energy Gx^2 + Gy^2 summed over x in [x0, x1) of row r0 (rm, rp: the rows
+// above and below), separably: column sums and differences first.
+[[gnu::always_inline]] inline float sobel_energy(const float* rm, const float* r0, const float* rp, int x0, int x1) {
+  Float8 e{};
+  int x = x0;
+  const Float8 two = {2, 2, 2, 2, 2, 2, 2, 2};
+  for (; x + 8 <= x1; x += 8) {
+    const Float8 ml = load8(rm + x - 1), mc = load8(rm + x), mr = load8(rm + x + 1);
+    const Float8 cl = load8(r0 + x - 1), cr = load8(r0 + x + 1);
+    const Float8 pl = load8(rp + x - 1), pc = load8(rp + x), pr = load8(rp + x + 1);
+    const Float8 gx = (mr + two * cr + pr) - (ml + two * cl + pl);
+    const Float8 gy = (pl + two * pc + pr) - (ml + two * mc + mr);
+    e += gx * gx + gy * gy;
+  }
+  float energy = sum8(e);
+  for (; x < x1; ++x) {
+    const float gx = (rm[x + 1] + 2 * r0[x + 1] + rp[x + 1]) - (rm[x - 1] + 2 * r0[x - 1] + rp[x - 1]);
+    const float gy = (rp[x - 1] + 2 * rp[x] + rp[x + 1]) - (rm[x - 1] + 2 * rm[x] + rm[x + 1]);
+    energy += gx * gx + gy * gy;
+  }
+  return energy;
+}
+
+// One sample tile of measure_detail().
+template <typename T>
+[[gnu::always_inline]] inline void detail_tile(const Image& image, const TileGrid& g, int i, int j, DetailSums& t,
+                                               TileScratch& scratch) {
+  const int x0 = g.x0(i), x1 = g.x1(i), y0 = g.y0(j), y1 = g.y1(j);
+  const int w = x1 - x0;
+  t = DetailSums{};
+  const float offset = static_cast<float>(image.row<T>(y0)[x0]);
+  t.offset = offset;
+
+  // The tile and a 1 px border (for Sobel) as floats minus the offset, converted once for all
+  // the sums below. Integer counts up to 65535 are exact in float. Fixed layout: buffer column
+  // x - x0 + 1, row y - y0 + 1; a border outside the image and the pad column after the right
+  // border hold zeros.
+  const int stride = g.tile + 3;
+  float* buffer = scratch.tile.data();
+  const int bx0 = std::max(x0 - 1, 0), bx1 = std::min(x1 + 1, g.width);
+  const int by0 = std::max(y0 - 1, 0), by1 = std::min(y1 + 1, g.height);
+  // Row y of the buffer, indexed by image column.
+  const auto row = [&](int y) { return buffer + static_cast<std::ptrdiff_t>(y - y0 + 1) * stride - (x0 - 1); };
+  for (int y = y0 - 1; y <= y1; ++y) {
+    float* dst = row(y);
+    if (y < by0 || y >= by1) {
+      std::fill(dst + x0 - 1, dst + x1 + 2, 0.0f);
+      continue;
+    }
+    const T* src = image.row<T>(y);
+#pragma omp simd
+    for (int x = bx0; x < bx1; ++x) dst[x] = static_cast<float>(src[x]) - offset;
+    if (bx0 == x0) dst[x0 - 1] = 0.0f;
+    if (bx1 == x1) dst[x1] = 0.0f;
+    dst[x1 + 1] = 0.0f;
+  }
+  const float* zeros = scratch.zeros.data() - x0;  // the rows past the tile's last, for the y lags
+  float* row_sums = scratch.row_sums.data();
+  // Sobel needs the 3 x 3 neighbourhood inside the image (it may reach into other tiles).
+  const int sx0 = std::max(x0, 1), sx1 = std::min(x1, g.width - 1);
+
+  for (int y = y0; y < y1; ++y) {
+    const float* r0 = row(y);
+    const float* r1 = y + 1 < y1 ? row(y + 1) : zeros;
+    const float* r2 = y + 2 < y1 ? row(y + 2) : zeros;
+    // Moments and the four lag products in one sweep over the whole row (whole vectors); the x
+    // products that reach past the tile's last column (into the border, then the zero pad) are
+    // taken off after.
+    const RowSums r = row_sums_and_lags(r0, r1, r2, x0, x1);
+    const float s = r.s, ss = r.ss, py1 = r.py1, py2 = r.py2;
+    const float px1 = r.px1 - r0[x1 - 1] * r0[x1];
+    const float px2 = w > 1 ? r.px2 - r0[x1 - 2] * r0[x1] : 0.0f;
+    row_sums[y - y0] = s;
+    t.n += w;
+    t.sum += s;
+    t.sumsq += ss;
     // Lags along x: pairs (x, x + 1) and (x, x + 2) inside the tile. The sums of either member
     // are the row sum without the end pixels.
-    float products = 0, unused = 0;
     if (w > 1) {
-      row_products(r0, r0, x0, x1 - 1, 1, products, unused);
       t.pairs[lag_x1] += w - 1;
-      t.sum_xy[lag_x1] += products;
+      t.sum_xy[lag_x1] += px1;
       t.sum_x[lag_x1] += s - r0[x1 - 1];
       t.sum_y[lag_x1] += s - r0[x0];
     }
     if (w > 2) {
-      row_products(r0, r0, x0, x1 - 2, 2, products, unused);
       t.pairs[lag_x2] += w - 2;
-      t.sum_xy[lag_x2] += products;
+      t.sum_xy[lag_x2] += px2;
       t.sum_x[lag_x2] += s - r0[x1 - 1] - r0[x1 - 2];
       t.sum_y[lag_x2] += s - r0[x0] - r0[x0 + 1];
     }
-    // Lags along y: rows y + 1 and y + 2 of the same tile.
-    for (int step = 1; step <= 2; ++step) {
-      if (y + step >= y1) break;
-      float sum_next = 0;
-      row_products(r0, row(y + step), x0, x1, 0, products, sum_next);
-      const int lag = step == 1 ? lag_y1 : lag_y2;
-      t.pairs[lag] += w;
-      t.sum_xy[lag] += products;
-      t.sum_x[lag] += s;
-      t.sum_y[lag] += sum_next;
+    // Lags along y: rows y + 1 and y + 2 of the same tile (their sums are added below).
+    if (y + 1 < y1) {
+      t.pairs[lag_y1] += w;
+      t.sum_xy[lag_y1] += py1;
+      t.sum_x[lag_y1] += s;
+    }
+    if (y + 2 < y1) {
+      t.pairs[lag_y2] += w;
+      t.sum_xy[lag_y2] += py2;
+      t.sum_x[lag_y2] += s;
     }
 
     // Tenengrad: Sobel gradient energy (the offset cancels in the differences).
     if (y >= 1 && y + 1 < g.height && sx1 > sx0) {
       const float* rm = row(y - 1);
       const float* rp = row(y + 1);
-      float energy = 0;
-#pragma omp simd reduction(+ : energy)
-      for (int x = sx0; x < sx1; ++x) {
-        const float gx = (rm[x + 1] + 2 * r0[x + 1] + rp[x + 1]) - (rm[x - 1] + 2 * r0[x - 1] + rp[x - 1]);
-        const float gy = (rp[x - 1] + 2 * rp[x] + rp[x + 1]) - (rm[x - 1] + 2 * rm[x] + rm[x + 1]);
-        energy += gx * gx + gy * gy;
-      }
+      const float energy = sobel_energy(rm, r0, rp, sx0, sx1);
       t.sobel += energy;
       t.sobel_n += sx1 - sx0;
     }
-
-    if ((y - y0) % kSampleStep == kSampleStep / 2)
-      for (int xs = x0 + kSampleStep / 2; xs < x1; xs += kSampleStep) sample[samples++] = raw[xs];
   }
-  if (samples == 0) sample[samples++] = image.row<T>(y0)[x0];  // a sliver of a tile
-  tile_background<T>(image, x0, x1, y0, y1, samples, t, scratch);
+  // The second member of a y pair is in row y + lag.
+  for (int y = y0 + 1; y < y1; ++y) {
+    t.sum_y[lag_y1] += row_sums[y - y0];
+    if (y >= y0 + 2) t.sum_y[lag_y2] += row_sums[y - y0];
+  }
 }
 
 template <typename T>
-void accumulate_all(const Image& image, const TileGrid& g, int full_scale, std::vector<std::uint32_t>& histogram,
-                    std::vector<TileSums>& tiles, TileScratch& scratch) {
-  // Tile rows outer, so a band of tile + 2 image rows stays in cache while its tiles are done.
-  for (int j = 0; j < g.ny; ++j)
-    for (int i = 0; i < g.nx; ++i)
-      accumulate_tile<T>(image, g, i, j, full_scale, histogram.data(), tiles[static_cast<std::size_t>(i + g.nx * j)],
-                         scratch);
+[[gnu::always_inline]] inline void detail_all(const Image& image, const TileGrid& g, const DetailLattice& lattice,
+                                              DetailSums* sums, TileScratch& scratch) {
+  for (int c = 0; c < lattice.count(); ++c)
+    detail_tile<T>(image, g, lattice.tile_i(c % lattice.nx), lattice.tile_j(c / lattice.nx), sums[c], scratch);
+}
+
+[[gnu::target_clones("arch=x86-64-v3", "default")]] void detail_all_u16(const Image& image, const TileGrid& g,
+                                                                        const DetailLattice& lattice,
+                                                                        DetailSums* sums, TileScratch& scratch) {
+  detail_all<std::uint16_t>(image, g, lattice, sums, scratch);
+}
+
+[[gnu::target_clones("arch=x86-64-v3", "default")]] void detail_all_u8(const Image& image, const TileGrid& g,
+                                                                       const DetailLattice& lattice, DetailSums* sums,
+                                                                       TileScratch& scratch) {
+  detail_all<std::uint8_t>(image, g, lattice, sums, scratch);
 }
 
 // Horizontal maximum of each pixel and its left and right neighbours, for x in [1, w - 1).
@@ -260,30 +370,56 @@ std::span<const std::uint32_t> histogram_halves(std::vector<std::uint32_t>& hist
   return {histogram.data(), values};
 }
 
-double TileSums::variance() const {
+DetailLattice::DetailLattice(const TileGrid& grid, int max_tiles) : tiles_x(grid.nx), tiles_y(grid.ny) {
+  const auto blocks = [&](int k) { return ((grid.nx + k - 1) / k) * ((grid.ny + k - 1) / k); };
+  while (blocks(step) > max_tiles && step < std::max(grid.nx, grid.ny)) ++step;
+  nx = (grid.nx + step - 1) / step;
+  ny = (grid.ny + step - 1) / step;
+}
+
+void TileScratch::reserve(const TileGrid& grid) {
+  const auto t = static_cast<std::size_t>(grid.tile);
+  tile.resize((t + 3) * (t + 2));  // each is a no-op once sized
+  row_sums.resize(t);
+  zeros.assign(t + 2, 0.0f);
+  const std::size_t per_row = t / kSampleStep + 1;
+  sample.resize(per_row * per_row);
+  histogram.resize(kTileBins);
+  maxima_rows.resize(3 * static_cast<std::size_t>(grid.width));
+}
+
+double DetailSums::variance() const {
   if (n <= 0) return 0.0;
   const double m = sum / n;
   return std::max(0.0, sumsq / n - m * m);
 }
 
-double TileSums::covariance(int lag) const {
+double DetailSums::covariance(int lag) const {
   const double p = pairs[lag];
   if (p <= 0 || n <= 0) return 0.0;
   const double m = sum / n;  // about the tile mean, in offset units like the sums
   return (sum_xy[lag] - m * (sum_x[lag] + sum_y[lag])) / p + m * m;
 }
 
-void accumulate(const Image& image, const TileGrid& grid, int full_scale, std::vector<std::uint32_t>& histogram,
-                std::vector<TileSums>& tiles, TileScratch& scratch) {
+void scan_tiles(const Image& image, const TileGrid& grid, int full_scale, std::vector<std::uint32_t>& histogram,
+                std::vector<TileLevel>& tiles, TileScratch& scratch) {
   if (image.type() == SampleType::u8)
-    accumulate_all<std::uint8_t>(image, grid, full_scale, histogram, tiles, scratch);
+    scan_all_u8(image, grid, full_scale, histogram.data(), tiles.data(), scratch);
   else
-    accumulate_all<std::uint16_t>(image, grid, full_scale, histogram, tiles, scratch);
+    scan_all_u16(image, grid, full_scale, histogram.data(), tiles.data(), scratch);
+}
+
+void measure_detail(const Image& image, const TileGrid& grid, const DetailLattice& lattice,
+                    std::vector<DetailSums>& sums, TileScratch& scratch) {
+  if (image.type() == SampleType::u8)
+    detail_all_u8(image, grid, lattice, sums.data(), scratch);
+  else
+    detail_all_u16(image, grid, lattice, sums.data(), scratch);
 }
 
 std::uint64_t count_maxima(const Image& image, const TileGrid& grid, const std::vector<std::int32_t>& thresholds,
-                           std::vector<std::uint32_t>& per_tile, std::vector<std::uint16_t>& ring) {
-  ring.resize(3 * static_cast<std::size_t>(grid.width));  // no allocation once sized
+                           std::vector<std::uint32_t>& per_tile, TileScratch& scratch) {
+  std::vector<std::uint16_t>& ring = scratch.maxima_rows;
   if (image.type() == SampleType::u8)
     return count_all_u8(image, grid, thresholds, per_tile, reinterpret_cast<std::uint8_t*>(ring.data()));
   return count_all_u16(image, grid, thresholds, per_tile, ring.data());
