@@ -50,14 +50,15 @@ double half_sample_mode(std::span<const std::uint32_t> histogram) {
   --hi;  // inclusive from here on
   // Each pass keeps a strictly narrower run (a run of half the pixels always exists that is
   // shorter than the whole), so this ends; the bound only guards against a mistake.
+  // Counts in integers: exact, and one-cycle adds in the two-pointer loop.
+  std::uint64_t mass = 0;  // in [lo, hi]
+  for (std::size_t v = lo; v <= hi; ++v) mass += histogram[v];
   for (int pass = 0; pass < 64 && hi - lo + 1 > 3; ++pass) {
-    double mass = 0;
-    for (std::size_t v = lo; v <= hi; ++v) mass += histogram[v];
-    const double half = std::ceil(mass / 2);
+    const std::uint64_t half = (mass + 1) / 2;
     // Narrowest [a, b] with at least `half` pixels (two pointers over the bins); of equally
     // narrow runs the fullest, so that integer bins do not pull the mode to one side.
     std::size_t best_a = lo, best_b = hi, b = lo;
-    double best_inside = 0, inside = histogram[lo];
+    std::uint64_t best_inside = 0, inside = histogram[lo];
     for (std::size_t a = lo; a <= hi; ++a) {
       while (inside < half && b < hi) inside += histogram[++b];
       if (inside < half) break;
@@ -71,6 +72,7 @@ double half_sample_mode(std::span<const std::uint32_t> histogram) {
     if (best_b - best_a >= hi - lo) break;
     lo = best_a;
     hi = best_b;
+    mass = best_inside;
   }
   double sum = 0, weighted = 0;
   for (std::size_t v = lo; v <= hi; ++v) {

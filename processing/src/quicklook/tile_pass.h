@@ -90,8 +90,9 @@ struct TileScratch {
   std::vector<float> tile;               // (tile + 3) x (tile + 2): a tile, its border and a pad column as floats
   std::vector<float> row_sums;           // tile entries: a sample tile's row sums
   std::vector<float> zeros;              // tile + 2 entries of 0: the row past a tile's last
-  std::vector<std::uint16_t> sample;     // (tile / kSampleStep + 1)^2 entries
-  std::vector<std::uint32_t> histogram;  // kTileBins entries
+  std::vector<std::uint16_t> sample;     // (tile / kSampleStep + 1)^2 entries per tile of a band
+  std::vector<std::uint32_t> band_samples, band_saturated;  // per tile of a band
+  std::vector<std::uint32_t> histogram;  // 2 x kTileBins entries (two halves, added up)
   std::vector<std::uint16_t> maxima_rows;  // 3 x width: count_maxima's ring of row maxima
 
   void reserve(const TileGrid& grid);
