@@ -5,12 +5,13 @@
 
 #include <fmt/format.h>
 
+#include "thread_priority.h"
 #include "tomorig/core/error.h"
 
 namespace tomorig::pipeline::quicklook_stage {
 
-PreviewWorker::PreviewWorker(std::function<Parts()> build, std::size_t cameras, Outputs outputs)
-    : build_(std::move(build)), cameras_(cameras), outputs_(std::move(outputs)) {
+PreviewWorker::PreviewWorker(std::function<Parts()> build, std::size_t cameras, Outputs outputs, int nice)
+    : build_(std::move(build)), cameras_(cameras), outputs_(std::move(outputs)), nice_(nice) {
   thread_ = std::thread([this] { work(); });
 }
 
@@ -49,6 +50,10 @@ PreviewWorker::State PreviewWorker::state() const {
 }
 
 void PreviewWorker::work() {
+  if (std::string error = lower_this_thread_priority(nice_); !error.empty()) {
+    std::lock_guard lock(mutex_);
+    state_.priority_error = std::move(error);
+  }
   try {
     Parts parts = build_();
     preview_ = std::move(parts.preview);

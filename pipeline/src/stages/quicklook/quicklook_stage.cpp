@@ -9,6 +9,10 @@
 //   --stage quicklook:publish=tcp://127.0.0.1:5557     and published (tomorig run --preview does this)
 //   --stage quicklook:preview=off                      statistics and Δt check only
 //   --stage quicklook:preview=ment,threads=2           MENT previews on two threads
+//   --stage quicklook:nice=5,preview_nice=15           the threads' nice values (the defaults)
+//
+// The recorder comes first: the stage's threads run at raised nice values (thread_priority.h),
+// the statistics of every set above the preview volume, which skips sets to stay current.
 #include <chrono>
 #include <memory>
 #include <mutex>
@@ -19,6 +23,7 @@
 
 #include "preview_worker.h"
 #include "quicklook_report.h"
+#include "thread_priority.h"
 #include "tomorig/core/error.h"
 #include "tomorig/pipeline/quicklook_settings.h"
 #include "tomorig/pipeline/session_geometry.h"
@@ -44,6 +49,11 @@ class QuickLookStage final : public Stage {
     if (thumbnail_px_ < 16 || thumbnail_px_ > 1024)
       throw bad_input(fmt::format("stage 'quicklook': thumbnail_px = {} is out of range: use 16 to 1024", thumbnail_px_));
     calib_ = table.text("calib", calib_);
+    for (auto [key, value] : {std::pair{"nice", &nice_}, std::pair{"preview_nice", &preview_nice_}}) {
+      *value = static_cast<int>(table.integer(key, *value));
+      if (*value < 0 || *value > 19)
+        throw bad_input(fmt::format("stage 'quicklook': {} = {} is out of range: use 0 to 19", key, *value));
+    }
     // Bound now, so a taken or forbidden address fails before the rig is armed.
     if (!publish_.empty() && publish_ != "none") {
       stream::SocketOptions options = stream::preview_socket_options(publish_);
@@ -59,6 +69,8 @@ class QuickLookStage final : public Stage {
     settings.preview.validate();
     settings.store = store_;
     settings.thumbnail_px = thumbnail_px_;
+    settings.nice = nice_;
+    settings.preview_nice = preview_nice_;
     settings_ = settings;
     store_quicklook_ = store_ ? recording.store_quicklook : nullptr;
 
@@ -74,6 +86,12 @@ class QuickLookStage final : public Stage {
 
   void process(const FrameSet& set) override {
     const auto taken = Clock::now();
+    // process() runs on the stage's own thread (StageRunner gives every stage that may skip
+    // sets one, stage_chain.cpp), never on the recorder's, so this lowers the quick-look alone.
+    if (!priority_lowered_) {
+      priority_error_ = lower_this_thread_priority(settings_.nice);
+      priority_lowered_ = true;
+    }
     if (set.cameras.size() != results_.size())
       throw bad_input(fmt::format("stage 'quicklook': set {} has {} cameras but the recording has {}", set.set_index,
                                   set.cameras.size(), results_.size()));
@@ -148,6 +166,9 @@ class QuickLookStage final : public Stage {
                    : !s.disabled.empty() ? nlohmann::json(fmt::format("off: {}", s.disabled))
                                          : nlohmann::json(settings_.preview.algorithm);
     j["preview_failures"] = s.failures;
+    j["nice"] = {{"statistics", settings_.nice}, {"preview", settings_.preview_nice}};
+    if (!priority_error_.empty()) j["nice_error"] = priority_error_;
+    if (!s.priority_error.empty()) j["preview_nice_error"] = s.priority_error;
     if (!s.last_error.empty()) j["preview_error"] = s.last_error;
     j["preview_latency_s"] = {{"max", s.latency_max_s},
                               {"mean", s.previews > 0 ? nlohmann::json(s.latency_sum_s / static_cast<double>(s.previews))
@@ -184,7 +205,8 @@ class QuickLookStage final : public Stage {
     PreviewWorker::Outputs outputs;
     if (publisher_) outputs.publish = [this](stream::PreviewMessage m) { publish(m); };
     if (store_quicklook_) outputs.store = store_quicklook_;
-    worker_ = std::make_unique<PreviewWorker>(std::move(build), recording.cameras.size(), std::move(outputs));
+    worker_ = std::make_unique<PreviewWorker>(std::move(build), recording.cameras.size(), std::move(outputs),
+                                              settings.preview_nice);
   }
 
   // Both threads publish: one socket, used by one at a time.
@@ -200,6 +222,10 @@ class QuickLookStage final : public Stage {
   std::string preview_ = "on";
   std::optional<int> threads_;
   int thumbnail_px_ = QuickLookSettings{}.thumbnail_px;
+  int nice_ = QuickLookSettings{}.nice;
+  int preview_nice_ = QuickLookSettings{}.preview_nice;
+  bool priority_lowered_ = false;
+  std::string priority_error_;
   std::string calib_;
 
   QuickLookSettings settings_;
