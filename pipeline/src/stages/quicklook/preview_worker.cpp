@@ -1,5 +1,7 @@
 #include "preview_worker.h"
 
+#include <time.h>
+
 #include <algorithm>
 #include <exception>
 
@@ -9,6 +11,15 @@
 #include "tomorig/core/error.h"
 
 namespace tomorig::pipeline::quicklook_stage {
+namespace {
+
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+}  // namespace
 
 PreviewWorker::PreviewWorker(std::function<Parts()> build, std::size_t cameras, Outputs outputs, int nice)
     : build_(std::move(build)), cameras_(cameras), outputs_(std::move(outputs)), nice_(nice) {
@@ -72,8 +83,11 @@ void PreviewWorker::work() {
     Job job = std::move(*mailbox_);
     mailbox_.reset();
     lock.unlock();
+    const double cpu_start = thread_cpu_seconds();
     run(job);
+    const double cpu = thread_cpu_seconds() - cpu_start;
     lock.lock();
+    state_.cpu_seconds += cpu;
   }
 }
 

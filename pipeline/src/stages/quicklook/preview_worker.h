@@ -53,6 +53,7 @@ class PreviewWorker {
     DriftSummary drift;
     std::uint64_t previews = 0, skipped = 0, failures = 0, drift_alarm_sets = 0;
     double latency_max_s = 0, latency_sum_s = 0;  // from the stage taking a set to its preview done
+    double cpu_seconds = 0;  // the worker thread's CPU time on jobs
     std::string last_error;  // of the last job that failed, e.g. a frame without light
     std::string disabled;    // why there is no preview (no camera models, ...); empty: running
     std::string priority_error;  // why the thread's nice value could not be raised; empty: it was

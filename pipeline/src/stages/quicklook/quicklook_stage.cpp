@@ -13,6 +13,9 @@
 //
 // The recorder comes first: the stage's threads run at raised nice values (thread_priority.h),
 // the statistics of every set above the preview volume, which skips sets to stay current.
+#include <time.h>
+
+#include <atomic>
 #include <chrono>
 #include <memory>
 #include <mutex>
@@ -34,6 +37,13 @@ namespace {
 
 using namespace quicklook_stage;
 using Clock = std::chrono::steady_clock;
+
+// CPU time of the calling thread, s: what the quick-look costs, whatever else loads the machine.
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
 
 class QuickLookStage final : public Stage {
  public:
@@ -92,6 +102,12 @@ class QuickLookStage final : public Stage {
       priority_error_ = lower_this_thread_priority(settings_.nice);
       priority_lowered_ = true;
     }
+    const double cpu_start = thread_cpu_seconds();
+    struct AddCpu {  // also when a set throws
+      double start;
+      std::atomic<double>& total;
+      ~AddCpu() { total.store(total.load() + thread_cpu_seconds() - start); }
+    } add_cpu{cpu_start, cpu_seconds_};
     if (set.cameras.size() != results_.size())
       throw bad_input(fmt::format("stage 'quicklook': set {} has {} cameras but the recording has {}", set.set_index,
                                   set.cameras.size(), results_.size()));
@@ -166,6 +182,8 @@ class QuickLookStage final : public Stage {
                    : !s.disabled.empty() ? nlohmann::json(fmt::format("off: {}", s.disabled))
                                          : nlohmann::json(settings_.preview.algorithm);
     j["preview_failures"] = s.failures;
+    j["cpu_seconds"] = cpu_seconds_.load();  // the statistics thread's, in process()
+    j["preview_cpu_seconds"] = s.cpu_seconds;
     j["nice"] = {{"statistics", settings_.nice}, {"preview", settings_.preview_nice}};
     if (!priority_error_.empty()) j["nice_error"] = priority_error_;
     if (!s.priority_error.empty()) j["preview_nice_error"] = s.priority_error;
@@ -225,6 +243,7 @@ class QuickLookStage final : public Stage {
   int nice_ = QuickLookSettings{}.nice;
   int preview_nice_ = QuickLookSettings{}.preview_nice;
   bool priority_lowered_ = false;
+  std::atomic<double> cpu_seconds_{0.0};
   std::string priority_error_;
   std::string calib_;
 
