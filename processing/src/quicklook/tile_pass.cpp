@@ -15,38 +15,76 @@ namespace {
 // the bins (a power of two counts wide) narrow enough that the sampled 5th to 50th percentiles
 // span 16 to 32 of them; half-sample mode and lower-half noise as for
 // the whole frame (histogram_stats.h).
+// The samples' k_low-th and k_high-th smallest values (0-based), exactly: value v[i] is the k-th
+// when fewer than k + 1 values lie below it and at least k + 1 at or below it. For a tile's 64
+// samples the n^2 comparisons run in 16-bit vector lanes without a branch, a third of the time
+// nth_element took; larger samples (tiles over 128 px) use nth_element.
+constexpr std::size_t kRankSelectMax = 256;
+static_assert(kTileBins <= 256, "tile_background keeps bin numbers in bytes");
+
+[[gnu::always_inline]] inline void select_two(std::uint16_t* v, std::size_t n, std::size_t k_low,
+                                              std::size_t k_high, int& low, int& high) {
+  if (n > kRankSelectMax) {
+    std::nth_element(v, v + k_high, v + n);
+    high = v[k_high];
+    std::nth_element(v, v + k_low, v + k_high);
+    low = v[k_low];
+    return;
+  }
+  const auto count = static_cast<int>(n);
+  for (int i = 0; i < count; ++i) {
+    const std::uint16_t x = v[i];
+    std::uint16_t below = 0, at = 0;  // n <= 256: no overflow
+#pragma omp simd reduction(+ : below, at)
+    for (int j = 0; j < count; ++j) {
+      below += static_cast<std::uint16_t>(v[j] < x);
+      at += static_cast<std::uint16_t>(v[j] == x);
+    }
+    if (below <= k_low && k_low < static_cast<std::size_t>(below + at)) low = x;
+    if (below <= k_high && k_high < static_cast<std::size_t>(below + at)) high = x;
+  }
+}
+
+// The tile's background level and noise from its own histogram (every other pixel of every other
+// row: 1024 of a 64 px tile): a window of kTileBins bins placed by the sampled 5th percentile,
+// the bins (a power of two counts wide) narrow enough that the sampled 5th to 50th percentiles
+// span 16 to 32 of them; half-sample mode and lower-half noise as for
+// the whole frame (histogram_stats.h).
 template <typename T>
-void tile_background(const Image& image, int x0, int x1, int y0, int y1, std::uint16_t* sample, std::size_t samples,
-                     TileLevel& t, TileScratch& scratch) {
-  const auto k5 = static_cast<std::ptrdiff_t>(0.05 * static_cast<double>(samples - 1));
-  const auto k50 = static_cast<std::ptrdiff_t>(0.50 * static_cast<double>(samples - 1));
-  // The median first, then the 5th percentile among the values below it (half the work).
-  std::nth_element(sample, sample + k50, sample + samples);
-  const int p50 = sample[k50];
-  std::nth_element(sample, sample + k5, sample + k50);
-  const int p5 = sample[k5];
+[[gnu::always_inline]] inline void tile_background(const Image& image, int x0, int x1, int y0, int y1,
+                                                   std::uint16_t* sample, std::size_t samples, TileLevel& t,
+                                                   TileScratch& scratch) {
+  const auto k5 = static_cast<std::size_t>(0.05 * static_cast<double>(samples - 1));
+  const auto k50 = static_cast<std::size_t>(0.50 * static_cast<double>(samples - 1));
+  int p5 = 0, p50 = 0;
+  select_two(sample, samples, k5, k50, p5, p50);
   // Bins of a power-of-two width: a shift, not a division, per pixel.
   int shift = 0;
   while ((32 << shift) < p50 - p5) ++shift;
   const int width = 1 << shift;
   const int origin = p5 - kTileBinsBelow * width;
 
-  // Two histograms for alternate samples (as for the frame's), added up after.
+  // Each sampled row's bin numbers first (a vector loop), then the increments, alternately
+  // into two histograms (as for the frame's), added up after.
   std::uint32_t* h = scratch.histogram.data();
   std::uint32_t* h2 = h + kTileBins;
   std::fill(h, h + 2 * kTileBins, 0u);
-  const auto bin = [&](T v) {
-    const int d = static_cast<int>(v) - origin;
-    return d < 0 ? 0 : std::min(kTileBins - 1, d >> shift);
-  };
+  std::uint8_t* index = scratch.bin_index.data();
+  const int m = (x1 - x0 + 1) / 2;  // columns x0, x0 + 2, ...
   for (int y = y0; y < y1; y += 2) {
-    const T* r = image.row<T>(y);
-    int x = x0;
-    for (; x + 2 < x1; x += 4) {
-      ++h[bin(r[x])];
-      ++h2[bin(r[x + 2])];
+    const T* r = image.row<T>(y) + x0;
+#pragma omp simd
+    for (int k = 0; k < m; ++k) {
+      const int d = static_cast<int>(r[2 * k]) - origin;
+      const int b = d < 0 ? 0 : d >> shift;
+      index[k] = static_cast<std::uint8_t>(b < kTileBins - 1 ? b : kTileBins - 1);
     }
-    if (x < x1) ++h[bin(r[x])];
+    int k = 0;
+    for (; k + 1 < m; k += 2) {
+      ++h[index[k]];
+      ++h2[index[k + 1]];
+    }
+    if (k < m) ++h[index[k]];
   }
   for (int b = 0; b < kTileBins; ++b) h[b] += h2[b];
   const std::span<const std::uint32_t> bins(h, kTileBins);
@@ -408,6 +446,7 @@ void TileScratch::reserve(const TileGrid& grid) {
   band_samples.resize(static_cast<std::size_t>(grid.nx));
   band_saturated.resize(static_cast<std::size_t>(grid.nx));
   histogram.resize(2 * kTileBins);
+  bin_index.resize(t / 2 + 1);
   maxima_rows.resize(3 * static_cast<std::size_t>(grid.width));
 }
 

@@ -82,7 +82,7 @@ struct DetailSums {
 // window of the tile's own histogram: 64 samples for a 64 px tile.
 constexpr int kSampleStep = 8;
 // The tile histogram: bins, and how many of them lie below the sample's 5th percentile.
-constexpr int kTileBins = 256;
+constexpr int kTileBins = 256;  // bin numbers fit a byte (tile_pass.cpp)
 constexpr int kTileBinsBelow = 64;
 
 // Scratch of the passes, sized by the first frame (reserve()) and reused.
@@ -93,6 +93,7 @@ struct TileScratch {
   std::vector<std::uint16_t> sample;     // (tile / kSampleStep + 1)^2 entries per tile of a band
   std::vector<std::uint32_t> band_samples, band_saturated;  // per tile of a band
   std::vector<std::uint32_t> histogram;  // 2 x kTileBins entries (two halves, added up)
+  std::vector<std::uint8_t> bin_index;   // tile / 2 + 1: a sampled row's bin numbers
   std::vector<std::uint16_t> maxima_rows;  // 3 x width: count_maxima's ring of row maxima
 
   void reserve(const TileGrid& grid);
