@@ -147,6 +147,33 @@ TEST(QuickLook, SampleTilesKeepTheFiguresAndMapTheFocusPerBlock) {
   EXPECT_NEAR(s.ppp.value, field.true_ppp(), 0.10 * field.true_ppp());
 }
 
+// A frame whose sides are no multiple of the tile (partial last tiles and a sample lattice
+// whose last block is partial): every figure still agrees with the truth, with every tile
+// sampled and with a few.
+TEST(QuickLook, OddFrameSizesAreMeasuredToTheEdges) {
+  FieldSpec spec;
+  spec.width = 1030;  // 16 tiles of 64 px and one of 6
+  spec.height = 771;  // 12 tiles and one of 3
+  const auto field = make_field(spec);
+  for (const int detail_tiles : {256, 16}) {
+    QuickLookOptions options;
+    options.detail_tiles = detail_tiles;
+    QuickLook ql(options);
+    FrameStatistics s;
+    ql.analyse(field.image, s);
+    EXPECT_EQ(s.background_map.tiles_x, 17);
+    EXPECT_EQ(s.background_map.tiles_y, 13);
+    EXPECT_LE(s.focus_map.tiles_x * s.focus_map.tiles_y, detail_tiles);
+    EXPECT_NEAR(s.ppp.value, field.true_ppp(), 0.10 * field.true_ppp()) << detail_tiles;
+    EXPECT_NEAR(s.diameter_px.value, 3.0, 0.3) << detail_tiles;
+    EXPECT_NEAR(s.background, spec.offset_counts, 2.0) << detail_tiles;
+    EXPECT_NEAR(s.noise, spec.read_noise_e, 0.75) << detail_tiles;
+    std::size_t focus = 0;
+    for (const float f : s.focus_map.values) focus += std::isfinite(f) ? 1 : 0;
+    EXPECT_GT(focus, s.focus_map.values.size() * 3 / 4) << detail_tiles;
+  }
+}
+
 TEST(QuickLook, LocalBackgroundFollowsAGradient) {
   FieldSpec spec;
   spec.ppp = 0.02;  // sparse: the particles' own lift of the background stays small (accuracy test)
