@@ -95,7 +95,7 @@ TEST(QuickLookStage, MeasuresEverySetItGetsAndStoresTheSheetOfItsPreviews) {
 }
 
 // The quick-look yields the CPU to the recorder: its statistics thread at nice 5, its preview
-// thread at nice 15 (the defaults), the thread that pushes the sets (the recorder's) untouched.
+// thread at nice 10 (the defaults), the thread that pushes the sets (the recorder's) untouched.
 // The store callback runs on the thread that produced the row, so it reads that thread's nice.
 TEST(QuickLookStage, ItsThreadsYieldToTheRecorder) {
   const DefaultRig rig;
@@ -116,12 +116,12 @@ TEST(QuickLookStage, ItsThreadsYieldToTheRecorder) {
   const pipeline::StageReport r = chain.end().at(0);
   EXPECT_TRUE(r.error.empty()) << r.error;
   EXPECT_EQ(r.status.at("nice").at("statistics"), 5);
-  EXPECT_EQ(r.status.at("nice").at("preview"), 15);
+  EXPECT_EQ(r.status.at("nice").at("preview"), 10);
   EXPECT_FALSE(r.status.contains("nice_error")) << r.status.dump();
   EXPECT_FALSE(r.status.contains("preview_nice_error")) << r.status.dump();
   bool statistics = false, preview = false;
   for (const auto& [is_preview, nice] : seen.rows) {
-    EXPECT_EQ(nice, std::max(pusher_nice, is_preview ? 15 : 5)) << (is_preview ? "preview" : "statistics");
+    EXPECT_EQ(nice, std::max(pusher_nice, is_preview ? 10 : 5)) << (is_preview ? "preview" : "statistics");
     (is_preview ? preview : statistics) = true;
   }
   EXPECT_TRUE(statistics && preview);

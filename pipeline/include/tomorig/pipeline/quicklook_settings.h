@@ -27,7 +27,7 @@ struct QuickLookSettings {
   // Nice values (0 to 19) of the stage's threads, so that they yield the CPU to the recorder
   // (nice 0): the statistics of every set before the preview volume, which may skip sets.
   int nice = 5;                 // the statistics and Δt check thread
-  int preview_nice = 15;        // the preview volume and drift monitor thread
+  int preview_nice = 10;        // the preview volume and drift monitor thread
 };
 
 // The library defaults with the rig file's [quicklook] keys applied (rig may be null: the

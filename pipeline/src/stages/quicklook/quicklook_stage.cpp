@@ -9,7 +9,7 @@
 //   --stage quicklook:publish=tcp://127.0.0.1:5557     and published (tomorig run --preview does this)
 //   --stage quicklook:preview=off                      statistics and Δt check only
 //   --stage quicklook:preview=ment,threads=2           MENT previews on two threads
-//   --stage quicklook:nice=5,preview_nice=15           the threads' nice values (the defaults)
+//   --stage quicklook:nice=5,preview_nice=10           the threads' nice values (the defaults)
 //
 // The recorder comes first: the stage's threads run at raised nice values (thread_priority.h),
 // the statistics of every set above the preview volume, which skips sets to stay current.
