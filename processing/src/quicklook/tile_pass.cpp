@@ -10,20 +10,17 @@
 namespace tomorig::quicklook::detail {
 namespace {
 
-// The tile's background level and noise from its own histogram (every other pixel of every other
-// row: 1024 of a 64 px tile): a window of kTileBins bins placed by the sampled 5th percentile,
-// the bins (a power of two counts wide) narrow enough that the sampled 5th to 50th percentiles
-// span 16 to 32 of them; half-sample mode and lower-half noise as for
-// the whole frame (histogram_stats.h).
 // The samples' k_low-th and k_high-th smallest values (0-based), exactly: value v[i] is the k-th
 // when fewer than k + 1 values lie below it and at least k + 1 at or below it. For a tile's 64
-// samples the n^2 comparisons run in 16-bit vector lanes without a branch, a third of the time
-// nth_element took; larger samples (tiles over 128 px) use nth_element.
+// samples the n^2 comparisons run in 16-bit vector lanes without a branch, a fraction of the
+// time nth_element took; larger samples (tiles over 128 px) use nth_element. `below` and `at`
+// are scratch of kRankSelectMax entries each.
 constexpr std::size_t kRankSelectMax = 256;
 static_assert(kTileBins <= 256, "tile_background keeps bin numbers in bytes");
 
 [[gnu::always_inline]] inline void select_two(std::uint16_t* v, std::size_t n, std::size_t k_low,
-                                              std::size_t k_high, int& low, int& high) {
+                                              std::size_t k_high, int& low, int& high, std::uint16_t* below,
+                                              std::uint16_t* at) {
   if (n > kRankSelectMax) {
     std::nth_element(v, v + k_high, v + n);
     high = v[k_high];
@@ -31,17 +28,23 @@ static_assert(kTileBins <= 256, "tile_background keeps bin numbers in bytes");
     low = v[k_low];
     return;
   }
+  // Ranks of all values at once: one sweep over the vector of all i per value j (no horizontal
+  // sums): below[i] = #{j: v[j] < v[i]}, at[i] = #{j: v[j] == v[i]} (n <= 256: no overflow).
   const auto count = static_cast<int>(n);
-  for (int i = 0; i < count; ++i) {
-    const std::uint16_t x = v[i];
-    std::uint16_t below = 0, at = 0;  // n <= 256: no overflow
-#pragma omp simd reduction(+ : below, at)
-    for (int j = 0; j < count; ++j) {
-      below += static_cast<std::uint16_t>(v[j] < x);
-      at += static_cast<std::uint16_t>(v[j] == x);
+  std::fill(below, below + count, std::uint16_t{0});
+  std::fill(at, at + count, std::uint16_t{0});
+  for (int j = 0; j < count; ++j) {
+    const std::uint16_t x = v[j];
+#pragma omp simd
+    for (int i = 0; i < count; ++i) {
+      below[i] += static_cast<std::uint16_t>(x < v[i]);
+      at[i] += static_cast<std::uint16_t>(x == v[i]);
     }
-    if (below <= k_low && k_low < static_cast<std::size_t>(below + at)) low = x;
-    if (below <= k_high && k_high < static_cast<std::size_t>(below + at)) high = x;
+  }
+  for (int i = 0; i < count; ++i) {
+    const std::size_t first = below[i], past = static_cast<std::size_t>(below[i] + at[i]);
+    if (first <= k_low && k_low < past) low = v[i];
+    if (first <= k_high && k_high < past) high = v[i];
   }
 }
 
@@ -57,7 +60,7 @@ template <typename T>
   const auto k5 = static_cast<std::size_t>(0.05 * static_cast<double>(samples - 1));
   const auto k50 = static_cast<std::size_t>(0.50 * static_cast<double>(samples - 1));
   int p5 = 0, p50 = 0;
-  select_two(sample, samples, k5, k50, p5, p50);
+  select_two(sample, samples, k5, k50, p5, p50, scratch.rank_below.data(), scratch.rank_at.data());
   // Bins of a power-of-two width: a shift, not a division, per pixel.
   int shift = 0;
   while ((32 << shift) < p50 - p5) ++shift;
@@ -447,6 +450,8 @@ void TileScratch::reserve(const TileGrid& grid) {
   band_saturated.resize(static_cast<std::size_t>(grid.nx));
   histogram.resize(2 * kTileBins);
   bin_index.resize(t / 2 + 1);
+  rank_below.resize(kRankSelectMax);
+  rank_at.resize(kRankSelectMax);
   maxima_rows.resize(3 * static_cast<std::size_t>(grid.width));
 }
 

@@ -94,6 +94,7 @@ struct TileScratch {
   std::vector<std::uint32_t> band_samples, band_saturated;  // per tile of a band
   std::vector<std::uint32_t> histogram;  // 2 x kTileBins entries (two halves, added up)
   std::vector<std::uint8_t> bin_index;   // tile / 2 + 1: a sampled row's bin numbers
+  std::vector<std::uint16_t> rank_below, rank_at;  // a tile sample's ranks (tile_pass.cpp)
   std::vector<std::uint16_t> maxima_rows;  // 3 x width: count_maxima's ring of row maxima
 
   void reserve(const TileGrid& grid);
