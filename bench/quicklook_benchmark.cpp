@@ -4,14 +4,21 @@
 // a double frame with the energy balance. DtCheck: the 4 x 4 windows of 64 px of one camera.
 // PreviewVolume: the MLOS preview of one exposure of the tpiv-thesis rig (4 x 512^2, 0.05 ppp:
 // binning, reconstruction on one thread, projections, depth profile), issue 16 item 3.
+// What the quicklook stage adds per camera and set besides the statistics and the Δt check:
+// Thumbnail (frame A shrunk to the stream's 160 px picture) and StatisticsJson (the camera's
+// figures and maps as the JSON of the preview stream).
 // Run on a quiet machine:  build/bench/quicklook_benchmark --benchmark_counters_tabular=true
 // The Time column is ms per frame, double frame or camera.
 #include <random>
 
 #include <benchmark/benchmark.h>
 
+#include <nlohmann/json.hpp>
+
 #include "tomorig/processing/calibration/pinhole_camera.h"
+#include "tomorig/processing/quicklook/display.h"
 #include "tomorig/processing/quicklook/dt_check.h"
+#include "tomorig/processing/quicklook/json.h"
 #include "tomorig/processing/quicklook/preview_volume.h"
 #include "tomorig/processing/quicklook/statistics.h"
 #include "tomorig/simulators/particle_renderer.h"
@@ -87,6 +94,27 @@ void BM_DtCheck(benchmark::State& state) {
   state.counters["valid_fraction"] = r.valid_fraction.value;
 }
 
+void BM_Thumbnail(benchmark::State& state) {
+  const Frames& f = frames();
+  for (auto _ : state) {
+    tomorig::Image t = tomorig::quicklook::thumbnail(f.a, 160);
+    benchmark::DoNotOptimize(t.data());
+  }
+}
+
+void BM_StatisticsJson(benchmark::State& state) {
+  const Frames& f = frames();
+  tomorig::quicklook::QuickLook ql;
+  tomorig::quicklook::CameraQuickLook s;
+  ql.analyse(f.a, f.b, s);
+  std::size_t bytes = 0;
+  for (auto _ : state) {
+    const nlohmann::json j = s;
+    bytes = j.dump().size();
+  }
+  state.counters["bytes"] = static_cast<double>(bytes);
+}
+
 }  // namespace
 
 void BM_PreviewVolume(benchmark::State& state) {
@@ -110,4 +138,6 @@ void BM_PreviewVolume(benchmark::State& state) {
 BENCHMARK(BM_QuickLookFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_QuickLookCamera)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_DtCheck)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Thumbnail)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_StatisticsJson)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_PreviewVolume)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -1,8 +1,11 @@
 // `tomorig inspect --png`: quick-look PNGs of one set that open in any image viewer.
+// `tomorig bench quicklook`: the recorder plus the quick-look at the rig's rate, and its figures.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "cli_runner.h"
 #include "tomorig/storage/image_file.h"
@@ -46,6 +49,37 @@ TEST(QuicklookCli, SetOutOfRangeIsBadInput) {
   const CliResult r = run_tomorig("inspect " + session + " --png " + shell_quoted((dir / "ql").string()) + " --set 5");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--set 5 is out of range"), std::string::npos) << r.err;
+}
+
+// Small frames keep this quick; the acceptance size is the default (4 x 2048^2 at 10 Hz).
+TEST(QuicklookCli, BenchReportsLossLatenessAndTheQuickLooksCpuTime) {
+  TempDir dir;
+  const std::string common = "bench quicklook --cameras 2 --side 128 --sets 4 --rate 20 --preview off --publish none "
+                             "--folder " + shell_quoted(dir.path().string());
+  const CliResult with = run_tomorig(common);
+  ASSERT_EQ(with.exit_code, 0) << with.err;
+  const nlohmann::json j = nlohmann::json::parse(with.out);
+  EXPECT_EQ(j["recorder"]["written"], 4);
+  EXPECT_EQ(j["recorder"]["lost"], 0);
+  EXPECT_GT(j["recorder"]["ms_per_set"].get<double>(), 0.0);
+  const nlohmann::json& q = j["quicklook"];
+  EXPECT_EQ(q["analysed"].get<int>() + q["skipped"].get<int>(), 4);
+  EXPECT_GE(q["analysed"].get<int>(), 1) << "the newest set is always analysed";
+  EXPECT_GT(q["cpu_ms_per_camera_frame"].get<double>(), 0.0);
+  EXPECT_GT(q["cpu_share"].get<double>(), 0.0);
+  EXPECT_EQ(q["status"]["nice"]["statistics"], 5);
+  EXPECT_NE(with.err.find("ms CPU"), std::string::npos) << with.err;
+
+  const CliResult alone = run_tomorig(common + " --quicklook off");
+  ASSERT_EQ(alone.exit_code, 0) << alone.err;
+  const nlohmann::json a = nlohmann::json::parse(alone.out);
+  EXPECT_EQ(a["recorder"]["written"], 4);
+  EXPECT_TRUE(a["quicklook"].is_null());
+  EXPECT_EQ(alone.err.find("quick-look analysed"), std::string::npos) << alone.err;
+
+  const CliResult bad = run_tomorig(common + " --quicklook maybe");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("--quicklook maybe"), std::string::npos) << bad.err;
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 // recording's store (statistics per set, the sheet and drift per preview) and judges them against
 // the simulator's truth; without camera models it still measures, and says why there is no preview.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <mutex>
@@ -90,6 +92,40 @@ TEST(QuickLookStage, MeasuresEverySetItGetsAndStoresTheSheetOfItsPreviews) {
   }
   EXPECT_EQ(statistics, r.processed);
   EXPECT_EQ(previews, r.status.at("previews").get<std::size_t>());
+}
+
+// The quick-look yields the CPU to the recorder: its statistics thread at nice 5, its preview
+// thread at nice 10 (the defaults), the thread that pushes the sets (the recorder's) untouched.
+// The store callback runs on the thread that produced the row, so it reads that thread's nice.
+TEST(QuickLookStage, ItsThreadsYieldToTheRecorder) {
+  const DefaultRig rig;
+  struct Seen {
+    std::mutex mutex;
+    std::vector<std::pair<bool, int>> rows;  // preview row?, the storing thread's nice
+  } seen;
+  pipeline::SessionDescription recording = rig.recording(true, nullptr);
+  recording.store_quicklook = [&seen](const storage::QuickLookRecord& r) {
+    const int nice = getpriority(PRIO_PROCESS, static_cast<id_t>(gettid()));
+    std::lock_guard lock(seen.mutex);
+    seen.rows.emplace_back(r.preview, nice);
+  };
+  const int pusher_nice = getpriority(PRIO_PROCESS, static_cast<id_t>(gettid()));
+  pipeline::StageChain chain = pipeline::make_chain(rig::all_stages(), {pipeline::parse_stage_spec("quicklook")});
+  chain.begin(recording);
+  chain.push(rig.simulated.render_set(0).frames);
+  const pipeline::StageReport r = chain.end().at(0);
+  EXPECT_TRUE(r.error.empty()) << r.error;
+  EXPECT_EQ(r.status.at("nice").at("statistics"), 5);
+  EXPECT_EQ(r.status.at("nice").at("preview"), 10);
+  EXPECT_FALSE(r.status.contains("nice_error")) << r.status.dump();
+  EXPECT_FALSE(r.status.contains("preview_nice_error")) << r.status.dump();
+  bool statistics = false, preview = false;
+  for (const auto& [is_preview, nice] : seen.rows) {
+    EXPECT_EQ(nice, std::max(pusher_nice, is_preview ? 10 : 5)) << (is_preview ? "preview" : "statistics");
+    (is_preview ? preview : statistics) = true;
+  }
+  EXPECT_TRUE(statistics && preview);
+  EXPECT_EQ(getpriority(PRIO_PROCESS, static_cast<id_t>(gettid())), pusher_nice) << "the pushing thread is untouched";
 }
 
 TEST(QuickLookStage, WithoutCameraModelsItMeasuresAndSaysWhyThereIsNoPreview) {
@@ -183,6 +219,8 @@ TEST(QuickLookStage, BadSettingsAreNamedBeforeAnySet) {
   };
   EXPECT_NE(message("quicklook:preview=fmart").find("preview = fmart"), std::string::npos);
   EXPECT_NE(message("quicklook:thumbnail_px=2").find("thumbnail_px"), std::string::npos);
+  EXPECT_NE(message("quicklook:nice=25").find("nice = 25"), std::string::npos);
+  EXPECT_NE(message("quicklook:preview_nice=-1").find("preview_nice = -1"), std::string::npos);
   EXPECT_NE(message("quicklook:publsh=tcp://127.0.0.1:5999").find("publsh"), std::string::npos);
   EXPECT_NE(message("quicklook:publish=tcp://0.0.0.0:5999").find("allow_remote"), std::string::npos);
 }

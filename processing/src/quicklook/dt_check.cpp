@@ -34,23 +34,30 @@ void check_frame(const Image& image, const char* what, int window) {
 template <typename T>
 double load_window(const Image& image, int x0, int y0, cv::Mat& out) {
   const int n = out.rows;
-  double sum = 0;
+  // Integer sums are exact and vectorise; the energy in float per row, double across rows.
+  std::uint64_t sum = 0;
   for (int y = 0; y < n; ++y) {
     const T* src = image.row<T>(y0 + y) + x0;
     float* dst = out.ptr<float>(y);
+    std::uint32_t row_sum = 0;
+#pragma omp simd reduction(+ : row_sum)
     for (int x = 0; x < n; ++x) {
       dst[x] = static_cast<float>(src[x]);
-      sum += dst[x];
+      row_sum += src[x];
     }
+    sum += row_sum;
   }
-  const auto mean = static_cast<float>(sum / (static_cast<double>(n) * n));
+  const auto mean = static_cast<float>(static_cast<double>(sum) / (static_cast<double>(n) * n));
   double energy = 0;
   for (int y = 0; y < n; ++y) {
     float* row = out.ptr<float>(y);
+    float e = 0;
+#pragma omp simd reduction(+ : e)
     for (int x = 0; x < n; ++x) {
       row[x] -= mean;
-      energy += static_cast<double>(row[x]) * row[x];
+      e += row[x] * row[x];
     }
+    energy += e;
   }
   return energy;
 }
@@ -152,19 +159,23 @@ void DtCheck::check(const Image& a, const Image& b, DtCheckResult& out) {
           }
       }
       const auto at = [&](int x, int y) { return w.plane.at<float>((y + n) % n, (x + n) % n); };
+      // The value test first: it rejects almost every point without the wrapped index sums.
       float second = -std::numeric_limits<float>::infinity();
-      for (int y = 0; y < n; ++y)
+      for (int y = 0; y < n; ++y) {
+        const float* row = w.plane.ptr<float>(y);
+        const int ddy = std::abs(shift_of((y - py + n) % n, n));
         for (int x = 0; x < n; ++x) {
-          const int ddx = std::abs(shift_of((x - px + n) % n, n)), ddy = std::abs(shift_of((y - py + n) % n, n));
-          if (std::max(ddx, ddy) <= kPeakExclusion) continue;
-          const float v = at(x, y);
+          const float v = row[x];
           if (v <= second) continue;
+          const int ddx = std::abs(shift_of((x - px + n) % n, n));
+          if (std::max(ddx, ddy) <= kPeakExclusion) continue;
           bool maximum = true;
           for (int ey = -1; ey <= 1 && maximum; ++ey)
             for (int ex = -1; ex <= 1 && maximum; ++ex)
               if ((ex || ey) && at(x + ex, y + ey) > v) maximum = false;
           if (maximum) second = v;
         }
+      }
       win.correlation = best / norm;
       win.peak_ratio = second > 0 ? std::min(kMaxPeakRatio, static_cast<double>(best / second)) : kMaxPeakRatio;
       w.scratch_r.push_back(win.peak_ratio);

@@ -2,12 +2,28 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace tomorig::quicklook::detail {
 namespace {
 
 // One-sided normal tail beyond 1 sigma over the half: P(Z < -1) / P(Z < 0).
 constexpr double kOneSigmaOfHalf = 0.158655253931457 / 0.5;
+
+// log(n) of the counts a tile's histogram holds (std::log's own values, looked up: the fit
+// below takes one per bin, for every tile of every frame); larger counts call std::log.
+constexpr std::size_t kLogTableSize = 4096;
+struct LogTable {
+  double value[kLogTableSize];
+  LogTable() {
+    value[0] = -std::numeric_limits<double>::infinity();
+    for (std::size_t n = 1; n < kLogTableSize; ++n) value[n] = std::log(static_cast<double>(n));
+  }
+};
+double log_count(std::uint32_t n) {
+  static const LogTable table;  // built once, thread-safe
+  return n < kLogTableSize ? table.value[n] : std::log(static_cast<double>(n));
+}
 
 }  // namespace
 
@@ -50,14 +66,15 @@ double half_sample_mode(std::span<const std::uint32_t> histogram) {
   --hi;  // inclusive from here on
   // Each pass keeps a strictly narrower run (a run of half the pixels always exists that is
   // shorter than the whole), so this ends; the bound only guards against a mistake.
+  // Counts in integers: exact, and one-cycle adds in the two-pointer loop.
+  std::uint64_t mass = 0;  // in [lo, hi]
+  for (std::size_t v = lo; v <= hi; ++v) mass += histogram[v];
   for (int pass = 0; pass < 64 && hi - lo + 1 > 3; ++pass) {
-    double mass = 0;
-    for (std::size_t v = lo; v <= hi; ++v) mass += histogram[v];
-    const double half = std::ceil(mass / 2);
+    const std::uint64_t half = (mass + 1) / 2;
     // Narrowest [a, b] with at least `half` pixels (two pointers over the bins); of equally
     // narrow runs the fullest, so that integer bins do not pull the mode to one side.
     std::size_t best_a = lo, best_b = hi, b = lo;
-    double best_inside = 0, inside = histogram[lo];
+    std::uint64_t best_inside = 0, inside = histogram[lo];
     for (std::size_t a = lo; a <= hi; ++a) {
       while (inside < half && b < hi) inside += histogram[++b];
       if (inside < half) break;
@@ -71,6 +88,7 @@ double half_sample_mode(std::span<const std::uint32_t> histogram) {
     if (best_b - best_a >= hi - lo) break;
     lo = best_a;
     hi = best_b;
+    mass = best_inside;
   }
   double sum = 0, weighted = 0;
   for (std::size_t v = lo; v <= hi; ++v) {
@@ -96,9 +114,10 @@ double refine_mode(std::span<const std::uint32_t> histogram, double mode, double
   double m[3][4] = {};
   int used = 0;
   for (std::ptrdiff_t v = lo; v <= hi; ++v) {
-    const double h = histogram[static_cast<std::size_t>(v)];
-    if (h < 1) continue;
-    const double u = static_cast<double>(v) - mode, y = std::log(h);
+    const std::uint32_t count = histogram[static_cast<std::size_t>(v)];
+    if (count < 1) continue;
+    const double h = count;
+    const double u = static_cast<double>(v) - mode, y = log_count(count);
     const double basis[3] = {1.0, u, u * u};
     for (int r = 0; r < 3; ++r) {
       for (int c = 0; c < 3; ++c) m[r][c] += h * basis[r] * basis[c];

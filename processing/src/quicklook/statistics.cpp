@@ -83,6 +83,8 @@ void QuickLookOptions::validate() const {
   if (bit_depth != 0 && (bit_depth < 8 || bit_depth > 16))
     throw bad_input(fmt::format("quicklook.bit_depth = {} is out of range: 8 to 16, or 0 for the sample type's",
                                 bit_depth));
+  if (detail_tiles < 1 || detail_tiles > 65536)
+    throw bad_input(fmt::format("quicklook.detail_tiles = {} is out of range: 1 to 65536 (default 256)", detail_tiles));
   if (histogram_bins < 2 || histogram_bins > 65536)
     throw bad_input(fmt::format("quicklook.histogram_bins = {} is out of range: 2 to 65536", histogram_bins));
   check_target(targets.ppp, "quicklook.ppp");
@@ -104,25 +106,27 @@ Flag CameraQuickLook::overall() const { return worst(worst(a.overall(), b.overal
 // Work buffers, sized by the first frame and reused.
 struct QuickLook::Work {
   detail::TileGrid grid;
+  detail::DetailLattice lattice;
   std::vector<std::uint32_t> histogram;  // full resolution: one bin per value
-  std::vector<detail::TileSums> tiles;
+  std::vector<detail::TileLevel> tiles;
+  std::vector<detail::DetailSums> detail;  // per block of the lattice
   detail::TileScratch tile_scratch;
   std::vector<std::int32_t> thresholds;
   std::vector<std::uint32_t> maxima;
   std::vector<float> scratch;
 
-  void prepare(const Image& image, int tile) {
-    if (grid.width != image.width() || grid.height != image.height() || grid.tile != tile)
+  void prepare(const Image& image, int tile, int detail_tiles) {
+    if (grid.width != image.width() || grid.height != image.height() || grid.tile != tile) {
       grid = detail::TileGrid(image.width(), image.height(), tile);
+      lattice = detail::DetailLattice(grid, detail_tiles);
+    }
     const std::size_t n = static_cast<std::size_t>(grid.count());
     tiles.resize(n);
+    detail.resize(static_cast<std::size_t>(lattice.count()));
     thresholds.resize(n);
     maxima.resize(n);
     scratch.reserve(n);
-    const std::size_t per_row = static_cast<std::size_t>(tile / detail::kSampleStep + 1);
-    tile_scratch.sample.resize(per_row * per_row);
-    tile_scratch.histogram.resize(detail::kTileBins);
-    tile_scratch.tile.resize(static_cast<std::size_t>(tile + 2) * static_cast<std::size_t>(tile + 2));
+    tile_scratch.reserve(grid);
     histogram.assign(2 * detail::kHistogramStride, 0u);
   }
 };
@@ -138,12 +142,15 @@ void QuickLook::analyse(const Image& image, FrameStatistics& out) {
   check_image(image, "the frame");
   const int full_scale = full_scale_of(image, options_.bit_depth);
   Work& w = *work_;
-  w.prepare(image, options_.tile_px);
+  w.prepare(image, options_.tile_px, options_.detail_tiles);
   const detail::TileGrid& g = w.grid;
+  const detail::DetailLattice& lattice = w.lattice;
   const QuickLookTargets& targets = options_.targets;
 
-  // ---- Pass 1: histogram and tile sums.
-  detail::accumulate(image, g, full_scale, w.histogram, w.tiles, w.tile_scratch);
+  // ---- Every pixel: histogram, saturation and each tile's background; the sample tiles:
+  // moments, autocovariance and Sobel sums.
+  detail::scan_tiles(image, g, full_scale, w.histogram, w.tiles, w.tile_scratch);
+  detail::measure_detail(image, g, lattice, w.detail, w.tile_scratch);
   const double pixels = static_cast<double>(image.width()) * image.height();
   out.width = image.width();
   out.height = image.height();
@@ -168,10 +175,10 @@ void QuickLook::analyse(const Image& image, FrameStatistics& out) {
   // ---- Background and noise: each tile's (tile_pass.h), the frame's the median over tiles, so
   // that a gradient of stray light neither blurs the level nor passes for noise.
   w.scratch.clear();
-  for (const detail::TileSums& t : w.tiles) w.scratch.push_back(static_cast<float>(t.background));
+  for (const detail::TileLevel& t : w.tiles) w.scratch.push_back(static_cast<float>(t.background));
   out.background = median_of(w.scratch);
   w.scratch.clear();
-  for (const detail::TileSums& t : w.tiles) w.scratch.push_back(static_cast<float>(t.noise));
+  for (const detail::TileLevel& t : w.tiles) w.scratch.push_back(static_cast<float>(t.noise));
   double noise = median_of(w.scratch);
   // A frame clipped at its lowest value (no black level) has no lower half to read the noise
   // from: the floor holds every negative excursion.
@@ -180,12 +187,12 @@ void QuickLook::analyse(const Image& image, FrameStatistics& out) {
                        hist[static_cast<std::size_t>(floor)] > kClippedFloorFraction * pixels;
   if (clipped) noise = detail::floor_clipped_sigma(hist, static_cast<int>(floor));
 
-  // ---- Tile sums: mean, saturation, autocovariance.
+  // ---- Mean (from the histogram), saturation, autocovariance (the sample tiles').
   double sum = 0, saturated = 0, weight = 0;
+  for (std::size_t v = 0; v < hist.size(); ++v) sum += static_cast<double>(v) * hist[v];
+  for (const detail::TileLevel& t : w.tiles) saturated += t.saturated;
   double cov[detail::lag_count] = {};
-  for (const detail::TileSums& t : w.tiles) {
-    sum += t.offset * t.n + t.sum;
-    saturated += t.saturated;
+  for (const detail::DetailSums& t : w.detail) {
     weight += t.n;
     for (int lag = 0; lag < detail::lag_count; ++lag) cov[lag] += t.n * t.covariance(lag);
   }
@@ -196,25 +203,29 @@ void QuickLook::analyse(const Image& image, FrameStatistics& out) {
   const double c1 = 0.5 * (cov[detail::lag_x1] + cov[detail::lag_y1]) / weight;
   const double c2 = 0.5 * (cov[detail::lag_x2] + cov[detail::lag_y2]) / weight;
   out.noise = std::max(noise, kQuantisationNoise);
-  // White noise alone leaves lag covariances of about noise^2 / sqrt(pixels) (either sign):
-  // both lags must stand well clear of that to say anything about particle images.
-  const double chance = kSignificance * out.noise * out.noise / std::sqrt(pixels);
+  // White noise alone leaves lag covariances of about noise^2 / sqrt(pixels) (either sign, the
+  // pixels the covariances are measured on): both lags must stand well clear of that to say
+  // anything about particle images.
+  const double chance = kSignificance * out.noise * out.noise / std::sqrt(weight);
   const double sigma_px = c1 > chance && c2 > chance ? detail::sigma_from_lag_ratio(c1 / c2) : not_measured;
   out.diameter_px.set(4.0 * sigma_px, targets.diameter_px);
 
   // ---- Local background and thresholds.
   resize_map(out.background_map, g);
   resize_map(out.saturation_map, g);
-  resize_map(out.focus_map, g);
+  out.focus_map.tiles_x = lattice.nx;
+  out.focus_map.tiles_y = lattice.ny;
+  out.focus_map.tile_px = g.tile * lattice.step;
+  out.focus_map.values.resize(static_cast<std::size_t>(lattice.count()));
   const double rise = options_.peak_sigmas * out.noise;
   w.scratch.clear();
   double background_sum = 0;
   for (std::size_t n = 0; n < w.tiles.size(); ++n) {
-    const detail::TileSums& t = w.tiles[n];
+    const detail::TileLevel& t = w.tiles[n];
     const double local = clipped ? std::max(floor, t.background) : t.background;
-    background_sum += local * t.n;
+    background_sum += local * t.pixels;
     out.background_map.values[n] = static_cast<float>(local);
-    out.saturation_map.values[n] = static_cast<float>(t.saturated / t.n);
+    out.saturation_map.values[n] = static_cast<float>(t.saturated / t.pixels);
     w.thresholds[n] = static_cast<std::int32_t>(std::clamp(std::floor(local + rise), -1.0, 65536.0));
     w.scratch.push_back(static_cast<float>(local));
   }
@@ -224,7 +235,7 @@ void QuickLook::analyse(const Image& image, FrameStatistics& out) {
   out.background_p95 = percentile_of(w.scratch, 0.95);
 
   // ---- Pass 2: particle images as local maxima.
-  const std::uint64_t maxima = detail::count_maxima(image, g, w.thresholds, w.maxima);
+  const std::uint64_t maxima = detail::count_maxima(image, g, w.thresholds, w.maxima, w.tile_scratch);
   const double interior = static_cast<double>(image.width() - 2) * (image.height() - 2);
   out.maxima_per_pixel = static_cast<double>(maxima) / interior;
 
@@ -237,20 +248,20 @@ void QuickLook::analyse(const Image& image, FrameStatistics& out) {
   out.source_density.set(ppp * std::numbers::pi / 4.0 * out.diameter_px.value * out.diameter_px.value,
                          targets.source_density);
 
-  // ---- Focus per tile, relative to the frame's median.
+  // ---- Focus per block of the lattice (its sample tile's), relative to the frame's median.
   const double noise_variance = out.noise * out.noise;
   w.scratch.clear();
-  for (std::size_t n = 0; n < w.tiles.size(); ++n) {
-    const detail::TileSums& t = w.tiles[n];
+  for (int c = 0; c < lattice.count(); ++c) {
+    const detail::DetailSums& t = w.detail[static_cast<std::size_t>(c)];
     const double signal_variance = t.variance() - noise_variance;
     float focus = std::numeric_limits<float>::quiet_NaN();
     // A tile needs particle signal well above its noise to say anything about focus.
-    if (t.sobel_n > 0 && signal_variance > noise_variance && w.maxima[n] > 0) {
+    if (t.sobel_n > 0 && signal_variance > noise_variance && w.maxima[lattice.tile_of(c)] > 0) {
       const double energy = t.sobel / t.sobel_n - kSobelNoise * noise_variance;
       focus = static_cast<float>(std::max(0.0, energy) / (kSobelGain2 * signal_variance));
       w.scratch.push_back(focus);
     }
-    out.focus_map.values[n] = focus;
+    out.focus_map.values[static_cast<std::size_t>(c)] = focus;
   }
   const double median_focus = median_of(w.scratch);
   if (std::isfinite(median_focus) && median_focus > 0) {

@@ -120,6 +120,60 @@ TEST(QuickLook, BlurredHalfOfTheFrameShowsInTheFocusMap) {
   EXPECT_EQ(blurred.soft_tile_fraction.flag, Flag::red);
 }
 
+// A frame with more tiles than detail_tiles: d_tau, the autocovariance ppp and focus come from
+// one tile in every block of tiles, and the focus map has one value per block. Here 16 sample
+// tiles of the 64 of a 512 px frame (blocks of 2 x 2 tiles).
+TEST(QuickLook, SampleTilesKeepTheFiguresAndMapTheFocusPerBlock) {
+  FieldSpec spec;
+  spec.ppp = 0.03;
+  QuickLookOptions options;
+  options.detail_tiles = 16;
+  QuickLook ql(options);
+  FrameStatistics s;
+  const Image image = half_blurred(spec, 256, 0.75, 2.0);
+  ql.analyse(image, s);
+  ASSERT_EQ(s.focus_map.tiles_x, 4);
+  ASSERT_EQ(s.focus_map.tiles_y, 4);
+  EXPECT_EQ(s.focus_map.tile_px, 128);
+  EXPECT_EQ(s.background_map.tiles_x, 8);  // the other maps keep every tile
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 2; ++i) EXPECT_GT(s.focus_map.at(i, j), 2 * s.focus_map.at(i + 2, j)) << i << ", " << j;
+  EXPECT_NEAR(s.soft_tile_fraction.value, 0.5, 0.07);
+
+  // Sharp everywhere: d_tau and ppp from the sample as from every tile, both against truth.
+  const auto field = make_field(spec);
+  ql.analyse(field.image, s);
+  EXPECT_NEAR(s.diameter_px.value, 3.0, 0.3);
+  EXPECT_NEAR(s.ppp.value, field.true_ppp(), 0.10 * field.true_ppp());
+}
+
+// A frame whose sides are no multiple of the tile (partial last tiles and a sample lattice
+// whose last block is partial): every figure still agrees with the truth, with every tile
+// sampled and with a few.
+TEST(QuickLook, OddFrameSizesAreMeasuredToTheEdges) {
+  FieldSpec spec;
+  spec.width = 1030;  // 16 tiles of 64 px and one of 6
+  spec.height = 771;  // 12 tiles and one of 3
+  const auto field = make_field(spec);
+  for (const int detail_tiles : {256, 16}) {
+    QuickLookOptions options;
+    options.detail_tiles = detail_tiles;
+    QuickLook ql(options);
+    FrameStatistics s;
+    ql.analyse(field.image, s);
+    EXPECT_EQ(s.background_map.tiles_x, 17);
+    EXPECT_EQ(s.background_map.tiles_y, 13);
+    EXPECT_LE(s.focus_map.tiles_x * s.focus_map.tiles_y, detail_tiles);
+    EXPECT_NEAR(s.ppp.value, field.true_ppp(), 0.10 * field.true_ppp()) << detail_tiles;
+    EXPECT_NEAR(s.diameter_px.value, 3.0, 0.3) << detail_tiles;
+    EXPECT_NEAR(s.background, spec.offset_counts, 2.0) << detail_tiles;
+    EXPECT_NEAR(s.noise, spec.read_noise_e, 0.75) << detail_tiles;
+    std::size_t focus = 0;
+    for (const float f : s.focus_map.values) focus += std::isfinite(f) ? 1 : 0;
+    EXPECT_GT(focus, s.focus_map.values.size() * 3 / 4) << detail_tiles;
+  }
+}
+
 TEST(QuickLook, LocalBackgroundFollowsAGradient) {
   FieldSpec spec;
   spec.ppp = 0.02;  // sparse: the particles' own lift of the background stays small (accuracy test)
@@ -244,6 +298,9 @@ TEST(QuickLook, BadInputIsRefusedWithAClearMessage) {
   QuickLookOptions bad;
   bad.tile_px = 8;
   EXPECT_NE(message([&] { QuickLook q(bad); }).find("tile_px"), std::string::npos);
+  bad = {};
+  bad.detail_tiles = 0;
+  EXPECT_NE(message([&] { QuickLook q(bad); }).find("detail_tiles"), std::string::npos);
   bad = {};
   bad.targets.ppp = {0.08, 0.02, 0.25};
   EXPECT_NE(message([&] { QuickLook q(bad); }).find("quicklook.ppp"), std::string::npos);

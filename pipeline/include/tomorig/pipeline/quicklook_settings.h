@@ -24,6 +24,10 @@ struct QuickLookSettings {
   bool store = true;            // quick-look numbers into the session file, when the recording has one
   std::string publish;          // PUB endpoint for the results; empty: none
   int thumbnail_px = 160;       // longest side of the camera thumbnails on the stream
+  // Nice values (0 to 19) of the stage's threads, so that they yield the CPU to the recorder
+  // (nice 0): the statistics of every set before the preview volume, which may skip sets.
+  int nice = 5;                 // the statistics and Δt check thread
+  int preview_nice = 10;        // the preview volume and drift monitor thread
 };
 
 // The library defaults with the rig file's [quicklook] keys applied (rig may be null: the

@@ -1,16 +1,28 @@
 #include "preview_worker.h"
 
+#include <time.h>
+
 #include <algorithm>
 #include <exception>
 
 #include <fmt/format.h>
 
+#include "thread_priority.h"
 #include "tomorig/core/error.h"
 
 namespace tomorig::pipeline::quicklook_stage {
+namespace {
 
-PreviewWorker::PreviewWorker(std::function<Parts()> build, std::size_t cameras, Outputs outputs)
-    : build_(std::move(build)), cameras_(cameras), outputs_(std::move(outputs)) {
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+}  // namespace
+
+PreviewWorker::PreviewWorker(std::function<Parts()> build, std::size_t cameras, Outputs outputs, int nice)
+    : build_(std::move(build)), cameras_(cameras), outputs_(std::move(outputs)), nice_(nice) {
   thread_ = std::thread([this] { work(); });
 }
 
@@ -49,6 +61,10 @@ PreviewWorker::State PreviewWorker::state() const {
 }
 
 void PreviewWorker::work() {
+  if (std::string error = lower_this_thread_priority(nice_); !error.empty()) {
+    std::lock_guard lock(mutex_);
+    state_.priority_error = std::move(error);
+  }
   try {
     Parts parts = build_();
     preview_ = std::move(parts.preview);
@@ -67,8 +83,11 @@ void PreviewWorker::work() {
     Job job = std::move(*mailbox_);
     mailbox_.reset();
     lock.unlock();
+    const double cpu_start = thread_cpu_seconds();
     run(job);
+    const double cpu = thread_cpu_seconds() - cpu_start;
     lock.lock();
+    state_.cpu_seconds += cpu;
   }
 }
 

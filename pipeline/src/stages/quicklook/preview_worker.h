@@ -37,8 +37,9 @@ class PreviewWorker {
   };
   // `build` makes the parts on the worker's own thread (working out the grid a camera sees
   // takes a moment the recorder must not wait for); if it throws, the worker stops, offers are
-  // ignored and state().disabled says why.
-  PreviewWorker(std::function<Parts()> build, std::size_t cameras, Outputs outputs);
+  // ignored and state().disabled says why. The thread runs at nice value `nice`
+  // (thread_priority.h), below the recorder and the statistics.
+  PreviewWorker(std::function<Parts()> build, std::size_t cameras, Outputs outputs, int nice);
   ~PreviewWorker();  // stops without processing the waiting job
   PreviewWorker(const PreviewWorker&) = delete;
   PreviewWorker& operator=(const PreviewWorker&) = delete;
@@ -52,8 +53,10 @@ class PreviewWorker {
     DriftSummary drift;
     std::uint64_t previews = 0, skipped = 0, failures = 0, drift_alarm_sets = 0;
     double latency_max_s = 0, latency_sum_s = 0;  // from the stage taking a set to its preview done
+    double cpu_seconds = 0;  // the worker thread's CPU time on jobs
     std::string last_error;  // of the last job that failed, e.g. a frame without light
     std::string disabled;    // why there is no preview (no camera models, ...); empty: running
+    std::string priority_error;  // why the thread's nice value could not be raised; empty: it was
   };
   State state() const;
 
@@ -66,6 +69,7 @@ class PreviewWorker {
   std::unique_ptr<quicklook::DriftMonitor> drift_;
   std::size_t cameras_;
   Outputs outputs_;
+  int nice_;
   quicklook::PreviewResult result_;  // reused
 
   mutable std::mutex mutex_;

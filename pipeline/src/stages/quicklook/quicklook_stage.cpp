@@ -9,6 +9,13 @@
 //   --stage quicklook:publish=tcp://127.0.0.1:5557     and published (tomorig run --preview does this)
 //   --stage quicklook:preview=off                      statistics and Δt check only
 //   --stage quicklook:preview=ment,threads=2           MENT previews on two threads
+//   --stage quicklook:nice=5,preview_nice=10           the threads' nice values (the defaults)
+//
+// The recorder comes first: the stage's threads run at raised nice values (thread_priority.h),
+// the statistics of every set above the preview volume, which skips sets to stay current.
+#include <time.h>
+
+#include <atomic>
 #include <chrono>
 #include <memory>
 #include <mutex>
@@ -19,6 +26,7 @@
 
 #include "preview_worker.h"
 #include "quicklook_report.h"
+#include "thread_priority.h"
 #include "tomorig/core/error.h"
 #include "tomorig/pipeline/quicklook_settings.h"
 #include "tomorig/pipeline/session_geometry.h"
@@ -29,6 +37,13 @@ namespace {
 
 using namespace quicklook_stage;
 using Clock = std::chrono::steady_clock;
+
+// CPU time of the calling thread, s: what the quick-look costs, whatever else loads the machine.
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
 
 class QuickLookStage final : public Stage {
  public:
@@ -44,6 +59,11 @@ class QuickLookStage final : public Stage {
     if (thumbnail_px_ < 16 || thumbnail_px_ > 1024)
       throw bad_input(fmt::format("stage 'quicklook': thumbnail_px = {} is out of range: use 16 to 1024", thumbnail_px_));
     calib_ = table.text("calib", calib_);
+    for (auto [key, value] : {std::pair{"nice", &nice_}, std::pair{"preview_nice", &preview_nice_}}) {
+      *value = static_cast<int>(table.integer(key, *value));
+      if (*value < 0 || *value > 19)
+        throw bad_input(fmt::format("stage 'quicklook': {} = {} is out of range: use 0 to 19", key, *value));
+    }
     // Bound now, so a taken or forbidden address fails before the rig is armed.
     if (!publish_.empty() && publish_ != "none") {
       stream::SocketOptions options = stream::preview_socket_options(publish_);
@@ -59,6 +79,8 @@ class QuickLookStage final : public Stage {
     settings.preview.validate();
     settings.store = store_;
     settings.thumbnail_px = thumbnail_px_;
+    settings.nice = nice_;
+    settings.preview_nice = preview_nice_;
     settings_ = settings;
     store_quicklook_ = store_ ? recording.store_quicklook : nullptr;
 
@@ -74,6 +96,18 @@ class QuickLookStage final : public Stage {
 
   void process(const FrameSet& set) override {
     const auto taken = Clock::now();
+    // process() runs on the stage's own thread (StageRunner gives every stage that may skip
+    // sets one, stage_chain.cpp), never on the recorder's, so this lowers the quick-look alone.
+    if (!priority_lowered_) {
+      priority_error_ = lower_this_thread_priority(settings_.nice);
+      priority_lowered_ = true;
+    }
+    const double cpu_start = thread_cpu_seconds();
+    struct AddCpu {  // also when a set throws
+      double start;
+      std::atomic<double>& total;
+      ~AddCpu() { total.store(total.load() + thread_cpu_seconds() - start); }
+    } add_cpu{cpu_start, cpu_seconds_};
     if (set.cameras.size() != results_.size())
       throw bad_input(fmt::format("stage 'quicklook': set {} has {} cameras but the recording has {}", set.set_index,
                                   set.cameras.size(), results_.size()));
@@ -148,6 +182,11 @@ class QuickLookStage final : public Stage {
                    : !s.disabled.empty() ? nlohmann::json(fmt::format("off: {}", s.disabled))
                                          : nlohmann::json(settings_.preview.algorithm);
     j["preview_failures"] = s.failures;
+    j["cpu_seconds"] = cpu_seconds_.load();  // the statistics thread's, in process()
+    j["preview_cpu_seconds"] = s.cpu_seconds;
+    j["nice"] = {{"statistics", settings_.nice}, {"preview", settings_.preview_nice}};
+    if (!priority_error_.empty()) j["nice_error"] = priority_error_;
+    if (!s.priority_error.empty()) j["preview_nice_error"] = s.priority_error;
     if (!s.last_error.empty()) j["preview_error"] = s.last_error;
     j["preview_latency_s"] = {{"max", s.latency_max_s},
                               {"mean", s.previews > 0 ? nlohmann::json(s.latency_sum_s / static_cast<double>(s.previews))
@@ -184,7 +223,8 @@ class QuickLookStage final : public Stage {
     PreviewWorker::Outputs outputs;
     if (publisher_) outputs.publish = [this](stream::PreviewMessage m) { publish(m); };
     if (store_quicklook_) outputs.store = store_quicklook_;
-    worker_ = std::make_unique<PreviewWorker>(std::move(build), recording.cameras.size(), std::move(outputs));
+    worker_ = std::make_unique<PreviewWorker>(std::move(build), recording.cameras.size(), std::move(outputs),
+                                              settings.preview_nice);
   }
 
   // Both threads publish: one socket, used by one at a time.
@@ -200,6 +240,11 @@ class QuickLookStage final : public Stage {
   std::string preview_ = "on";
   std::optional<int> threads_;
   int thumbnail_px_ = QuickLookSettings{}.thumbnail_px;
+  int nice_ = QuickLookSettings{}.nice;
+  int preview_nice_ = QuickLookSettings{}.preview_nice;
+  bool priority_lowered_ = false;
+  std::atomic<double> cpu_seconds_{0.0};
+  std::string priority_error_;
   std::string calib_;
 
   QuickLookSettings settings_;

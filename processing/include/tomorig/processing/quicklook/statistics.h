@@ -23,7 +23,9 @@
 // they and the vectors in `result` are sized by the first frame and reused afterwards, so
 // frames of an unchanged size allocate nothing. A QuickLook is not thread-safe: give each
 // camera (or thread) its own. Analysing one exposure alone: analyse(image, frame_statistics).
-// Cost: two passes over the frame plus per-tile work (bench/quicklook_benchmark.cpp).
+// Cost: two passes over every pixel (histogram and tile backgrounds; local maxima), and the
+// neighbourhood sums on a bounded sample of tiles (QuickLookOptions::detail_tiles), in loops
+// the compiler vectorises (bench/quicklook_benchmark.cpp).
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -52,6 +54,13 @@ struct QuickLookOptions {
   // Bit depth of the data, which sets the saturation level 2^bits - 1 (12 for Mono12 in
   // 16-bit samples); 0: the sample type's (8 or 16).
   int bit_depth = 0;
+  // The particle image diameter, the autocovariance ppp and the focus map need every pixel's
+  // neighbours (lag products, Sobel), so they are measured on a sample of at most this many
+  // tiles, one in every k x k block of tiles (k the smallest that fits), spread evenly over the
+  // frame: their cost is bounded whatever the frame size. Frames of up to this many tiles
+  // (1024 x 1024 px at 64 px tiles) are measured on every tile. The focus map has one value per
+  // block. Histogram, saturation, background and local maxima always use every pixel.
+  int detail_tiles = 256;
   // Bins of the display histogram, spread linearly over [0, full scale].
   int histogram_bins = 256;
   QuickLookTargets targets;
@@ -108,7 +117,8 @@ struct FrameStatistics {
   // Focus per tile (normalised Tenengrad): the Sobel gradient energy minus its noise part, over
   // 64 x the tile's variance minus the noise variance (px^-2). It depends on the particle image
   // shape only, not on brightness or density, and falls as the images blur. NaN for tiles
-  // without particle signal.
+  // without particle signal. One value per block of k x k tiles (QuickLookOptions::
+  // detail_tiles; tile_px is the block's edge), measured on the tile nearest the block's centre.
   TileMap focus_map;
   Judged soft_tile_fraction;  // tiles (with signal) whose focus is below half the median
 
