@@ -105,7 +105,11 @@ void record(const RecordArgs& args) {
   // with the first set that can define them (an older sender announces nothing).
   rig::StreamSession session;
   std::optional<rig::Recorder> recorder;
-  auto open_recorder = [&](std::vector<storage::SessionCamera> cameras) {
+  // Opens the session for `cameras`, or says why it cannot (why_not_recordable): then nothing
+  // is created, and the sets that would need it are counted as refused.
+  auto open_recorder = [&](std::vector<storage::SessionCamera> cameras, std::string& why) {
+    why = rig::why_not_recordable(cameras, options);
+    if (!why.empty()) return false;
     storage::SessionInfo info = session.file_info(std::move(cameras), receiver.endpoint());
     rig::RecorderOptions o = options;
     o.cameras = std::move(info.cameras);
@@ -114,6 +118,7 @@ void record(const RecordArgs& args) {
     o.created_utc = std::move(info.created_utc);
     if (session.announced()) o.truth = session.announced()->truth;
     recorder.emplace(std::move(o));
+    return true;
   };
 
   RecordStatus status;
@@ -170,7 +175,9 @@ void record(const RecordArgs& args) {
         fmt::print(stderr, "record: session {:016x} from tomorig {}: {} cameras, rig config {} bytes{}\n", id,
                    s.info.software_version.empty() ? "(unknown version)" : s.info.software_version,
                    s.info.cameras.size(), s.info.rig_config_toml.size(), s.truth ? ", with truth" : "");
-        if (auto known = session.cameras_known_in_advance()) open_recorder(std::move(*known));
+        std::string why;
+        if (auto known = session.cameras_known_in_advance(); known && !open_recorder(std::move(*known), why))
+          fmt::print(stderr, "record: session {:016x} cannot be recorded ({}); its sets will be refused\n", id, why);
       }
       continue;
     }
@@ -188,11 +195,10 @@ void record(const RecordArgs& args) {
     std::string why;
     if (!recorder) {
       auto learned = session.cameras_from_first_set(set, why);
-      if (!learned) {
+      if (!learned || !open_recorder(std::move(*learned), why)) {
         print_refusal(++refused_before_start, "refused set", set.set_index, "it cannot start the session: " + why);
         continue;
       }
-      open_recorder(std::move(*learned));
     }
     const std::optional<storage::TruthSet> truth = session.take_truth(set.trigger_index);
     rig::Recorder::Outcome outcome;
@@ -267,6 +273,9 @@ void add_record_command(CLI::App& root) {
   cmd->add_flag("--overwrite", args->recorder.overwrite, "Replace an existing output file");
   cmd->add_option("--disk-reserve-mb", args->recorder.disk_reserve_mb,
                   "Stop recording cleanly when the disk would have less than this many MB free")
+      ->capture_default_str();
+  cmd->add_option("--max-set-mb", args->recorder.max_set_mb,
+                  "Refuse a first set larger than this many MB of pixels (it would size the session)")
       ->capture_default_str();
   cmd->add_flag("-v,--verbose", args->verbose, "Print a line for every set written");
   cmd->callback([args] { record(*args); });
