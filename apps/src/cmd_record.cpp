@@ -242,8 +242,8 @@ void record(const RecordArgs& args) {
                          end->reason.empty() ? "" : " (" + end->reason + ")");
   else if (!stopped_by.empty())
     ending = "; stopped: " + stopped_by;
-  fmt::print("{}; {} lost sets, {} refused sets, {} rejected messages{}\n", done.brief(), received.sets_missing,
-             done.refused, rejected, ending);
+  fmt::print("{}; {} lost sets, {} refused sets, {} rejected messages, {} session messages{}\n", done.brief(),
+             received.sets_missing, done.refused, rejected, received.session_messages, ending);
   fmt::print("next: tomorig inspect {}\n", done.out.string());
   if (end && end->sets_sent > received_sets)
     throw runtime_error(fmt::format("{} of the {} sets the sender sent never arrived; {} is complete with the {} that "
