@@ -34,6 +34,7 @@ struct RecordArgs {
   std::string from = "tcp://127.0.0.1:5555";
   bool bind = false;
   bool allow_remote = false;
+  std::string token;
   std::optional<std::uint64_t> sets;
   std::string compression = "none";
   std::optional<double> idle_timeout_s;
@@ -95,6 +96,7 @@ void record(const RecordArgs& args) {
   zmq::context_t context(1);
   stream::SocketOptions socket;
   socket.endpoint = {args.from, args.bind, args.allow_remote};
+  socket.endpoint.token = args.token;
   socket.timeout = kReceivePoll;
   stream::FrameReceiver receiver(context, socket);
   fmt::print(stderr, "record: {} {}, writing {}\n", args.bind ? "receiving on" : "receiving from", receiver.endpoint(),
@@ -244,6 +246,8 @@ void record(const RecordArgs& args) {
     ending = "; stopped: " + stopped_by;
   fmt::print("{}; {} lost sets, {} refused sets, {} rejected messages, {} session messages{}\n", done.brief(),
              received.sets_missing, done.refused, rejected, received.session_messages, ending);
+  if (const auto refused = stream::refused_connections(); refused.count > 0)
+    fmt::print("{} connections refused for a wrong token (last from {})\n", refused.count, refused.last_peer);
   fmt::print("next: tomorig inspect {}\n", done.out.string());
   if (end && end->sets_sent > received_sets)
     throw runtime_error(fmt::format("{} of the {} sets the sender sent never arrived; {} is complete with the {} that "
@@ -264,7 +268,8 @@ void add_record_command(CLI::App& root) {
   cmd->add_option("--from", args->from, "Stream endpoint of the sender (tomorig replay / acquire)")
       ->capture_default_str();
   cmd->add_flag("--bind", args->bind, "Bind --from instead of connecting (then the sender connects)");
-  cmd->add_flag("--allow-remote", args->allow_remote, "Allow --bind on a non-loopback address");
+  cmd->add_flag("--allow-remote", args->allow_remote, "Allow --bind on a non-loopback address (needs --token)");
+  cmd->add_option("--token", args->token, "Shared secret of the stream (default: $TOMORIG_STREAM_TOKEN); required beyond loopback, both sides alike");
   cmd->add_option("-o,--out", args->recorder.out, "Session file to write (.h5)")->required();
   cmd->add_option("--sets", args->sets, "Stop after this many sets (default: at the sender's end of acquisition, Ctrl-C or --idle-timeout)");
   cmd->add_option("--compression", args->compression, "Frame compression: none | bitshuffle-lz4")
