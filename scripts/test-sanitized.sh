@@ -34,5 +34,6 @@ cmake --build "$build_dir" -j "$jobs"
 # probe ends with _exit(), which runs no leak check, so only the test process itself is checked.
 export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:halt_on_error=1:abort_on_error=0:detect_stack_use_after_return=0}"
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}"
+export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$root/scripts/lsan-suppressions.txt:print_suppressions=0}"
 cd "$build_dir"
 ctest --output-on-failure -j "$jobs" --timeout 900 -E "$exclude_regex"
