@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # tomorig set-up in one command. On a fresh Debian 12 machine, as root (or with sudo):
 #   bash scripts/setup.sh run    install what is missing, build (Release), run the default rig
-#   bash scripts/setup.sh test   install what is missing, build (Release), run the test suite
+#   bash scripts/setup.sh test   install what is missing, build (Release), run the test suite, then
+#                                the library and CLI suites again under ASan + UBSan (second tree)
 # Packages come from scripts/apt-packages.txt, the one list of dependencies.
 set -euo pipefail
 
@@ -69,8 +70,9 @@ case "$mode" in
     exec "$build_dir/apps/tomorig" run "$@"
     ;;
   test)
-    cd "$build_dir"
-    ctest --output-on-failure -j "$jobs" --timeout 600
+    (cd "$build_dir" && ctest --output-on-failure -j "$jobs" --timeout 600)
+    # The same library and CLI suites built with ASan + UBSan (docs/reliability.md, "Sanitizers").
+    bash "$root/scripts/test-sanitized.sh"
     ;;
   build) ;;
 esac

@@ -9,6 +9,7 @@
 // message closes the session, so the recorder writes what `tomorig run` writes and stops by
 // itself.
 #include <cerrno>
+#include <algorithm>
 #include <chrono>
 #include <memory>
 #include <optional>
@@ -55,11 +56,15 @@ using Clock = std::chrono::steady_clock;
 using std::chrono::duration;
 using std::chrono::duration_cast;
 
+// The longest a send blocks before acquire looks at Ctrl-C again.
+constexpr std::chrono::milliseconds kSendSlice{50};
+
 struct AcquireOptions {
   RigRunChoices rig;
   std::string to = "tcp://127.0.0.1:5555";
   bool connect = false;
   bool allow_remote = false;
+  std::string token;
   double timeout_s = 10.0;
   double wait_s = 60.0;
 };
@@ -77,7 +82,12 @@ void acquire(const AcquireOptions& opt) {
   zmq::context_t context(1);
   stream::SocketOptions socket;
   socket.endpoint = {opt.to, !opt.connect, opt.allow_remote};
-  socket.timeout = duration_cast<std::chrono::milliseconds>(duration<double>(opt.timeout_s));
+  socket.endpoint.token = opt.token;
+  // Each send waits at most one slice, so Ctrl-C is seen within it even when the signal lands
+  // on another thread than the one blocked in ZeroMQ; send_with_retry keeps trying for
+  // --timeout (or --wait). Closing still waits one --timeout for queued sets.
+  socket.linger = duration_cast<std::chrono::milliseconds>(duration<double>(opt.timeout_s));
+  socket.timeout = std::min(kSendSlice, *socket.linger);
   auto sender = std::make_unique<stream::FrameSender>(context, socket);
   // The first line names the real endpoint (a "*" port resolved), for scripts and tests.
   fmt::print(stderr, "acquire: {} {}, rig '{}', {} cameras, {}\n", opt.connect ? "connected to" : "sending on",
@@ -103,8 +113,23 @@ void acquire(const AcquireOptions& opt) {
   session.info = rig_session_info(rig, rig_run);
   session.truth = rig_run.session_truth();
   // Waits (up to --wait) for a recorder before the trigger fires, so no set queues up
-  // unrecorded meanwhile; Ctrl-C while waiting ends the command with nothing acquired.
-  if (send_with_retry(*sender, session, opt.wait_s, &stop) == SendOutcome::stopped) {
+  // unrecorded meanwhile; Ctrl-C while waiting ends the command with nothing acquired. A
+  // connecting socket (--connect) would queue the session start with nobody there, so the
+  // wait is for a connected recorder, then for it to take the session start.
+  const auto wait_began = Clock::now();
+  bool stopped_waiting = false;
+  while (!sender->wait_for_receiver(kSendSlice)) {
+    if (stop.stop_requested()) {
+      stopped_waiting = true;
+      break;
+    }
+    if (duration<double>(Clock::now() - wait_began).count() >= opt.wait_s)
+      throw runtime_error(fmt::format("no recorder connected to {} within {:g} s (--wait): is 'tomorig record --{} {}' "
+                                      "running?",
+                                      sender->endpoint(), opt.wait_s, opt.connect ? "bind --from" : "from",
+                                      sender->endpoint()));
+  }
+  if (stopped_waiting || send_with_retry(*sender, session, opt.wait_s, &stop) == SendOutcome::stopped) {
     fmt::print("no recorder took the session start; stopped by {} before acquiring\n", stop.signal_name());
     return;
   }
@@ -185,7 +210,8 @@ void add_acquire_command(CLI::App& root) {
   add_rig_run_options(*cmd, opt->rig, "Acquire");
   cmd->add_option("--to", opt->to, "Stream endpoint (tcp://127.0.0.1:* picks a free port)")->capture_default_str();
   cmd->add_flag("--connect", opt->connect, "Connect --to instead of binding (the recorder binds)");
-  cmd->add_flag("--allow-remote", opt->allow_remote, "Allow binding --to on a non-loopback address");
+  cmd->add_flag("--allow-remote", opt->allow_remote, "Allow binding --to on a non-loopback address (needs --token)");
+  cmd->add_option("--token", opt->token, "Shared secret of the stream (default: $TOMORIG_STREAM_TOKEN); required beyond loopback, both sides alike");
   cmd->add_option("--timeout", opt->timeout_s, "Seconds a send may wait for the recorder before giving up")
       ->capture_default_str();
   cmd->add_option("--wait", opt->wait_s, "Seconds to wait for a recorder to take the session start (the trigger "

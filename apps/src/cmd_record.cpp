@@ -34,6 +34,7 @@ struct RecordArgs {
   std::string from = "tcp://127.0.0.1:5555";
   bool bind = false;
   bool allow_remote = false;
+  std::string token;
   std::optional<std::uint64_t> sets;
   std::string compression = "none";
   std::optional<double> idle_timeout_s;
@@ -95,6 +96,7 @@ void record(const RecordArgs& args) {
   zmq::context_t context(1);
   stream::SocketOptions socket;
   socket.endpoint = {args.from, args.bind, args.allow_remote};
+  socket.endpoint.token = args.token;
   socket.timeout = kReceivePoll;
   stream::FrameReceiver receiver(context, socket);
   fmt::print(stderr, "record: {} {}, writing {}\n", args.bind ? "receiving on" : "receiving from", receiver.endpoint(),
@@ -105,7 +107,11 @@ void record(const RecordArgs& args) {
   // with the first set that can define them (an older sender announces nothing).
   rig::StreamSession session;
   std::optional<rig::Recorder> recorder;
-  auto open_recorder = [&](std::vector<storage::SessionCamera> cameras) {
+  // Opens the session for `cameras`, or says why it cannot (why_not_recordable): then nothing
+  // is created, and the sets that would need it are counted as refused.
+  auto open_recorder = [&](std::vector<storage::SessionCamera> cameras, std::string& why) {
+    why = rig::why_not_recordable(cameras, options);
+    if (!why.empty()) return false;
     storage::SessionInfo info = session.file_info(std::move(cameras), receiver.endpoint());
     rig::RecorderOptions o = options;
     o.cameras = std::move(info.cameras);
@@ -114,6 +120,7 @@ void record(const RecordArgs& args) {
     o.created_utc = std::move(info.created_utc);
     if (session.announced()) o.truth = session.announced()->truth;
     recorder.emplace(std::move(o));
+    return true;
   };
 
   RecordStatus status;
@@ -170,7 +177,9 @@ void record(const RecordArgs& args) {
         fmt::print(stderr, "record: session {:016x} from tomorig {}: {} cameras, rig config {} bytes{}\n", id,
                    s.info.software_version.empty() ? "(unknown version)" : s.info.software_version,
                    s.info.cameras.size(), s.info.rig_config_toml.size(), s.truth ? ", with truth" : "");
-        if (auto known = session.cameras_known_in_advance()) open_recorder(std::move(*known));
+        std::string why;
+        if (auto known = session.cameras_known_in_advance(); known && !open_recorder(std::move(*known), why))
+          fmt::print(stderr, "record: session {:016x} cannot be recorded ({}); its sets will be refused\n", id, why);
       }
       continue;
     }
@@ -188,11 +197,10 @@ void record(const RecordArgs& args) {
     std::string why;
     if (!recorder) {
       auto learned = session.cameras_from_first_set(set, why);
-      if (!learned) {
+      if (!learned || !open_recorder(std::move(*learned), why)) {
         print_refusal(++refused_before_start, "refused set", set.set_index, "it cannot start the session: " + why);
         continue;
       }
-      open_recorder(std::move(*learned));
     }
     const std::optional<storage::TruthSet> truth = session.take_truth(set.trigger_index);
     rig::Recorder::Outcome outcome;
@@ -236,8 +244,10 @@ void record(const RecordArgs& args) {
                          end->reason.empty() ? "" : " (" + end->reason + ")");
   else if (!stopped_by.empty())
     ending = "; stopped: " + stopped_by;
-  fmt::print("{}; {} lost sets, {} refused sets, {} rejected messages{}\n", done.brief(), received.sets_missing,
-             done.refused, rejected, ending);
+  fmt::print("{}; {} lost sets, {} refused sets, {} rejected messages, {} session messages{}\n", done.brief(),
+             received.sets_missing, done.refused, rejected, received.session_messages, ending);
+  if (const auto refused = stream::refused_connections(); refused.count > 0)
+    fmt::print("{} connections refused for a wrong token (last from {})\n", refused.count, refused.last_peer);
   fmt::print("next: tomorig inspect {}\n", done.out.string());
   if (end && end->sets_sent > received_sets)
     throw runtime_error(fmt::format("{} of the {} sets the sender sent never arrived; {} is complete with the {} that "
@@ -258,7 +268,8 @@ void add_record_command(CLI::App& root) {
   cmd->add_option("--from", args->from, "Stream endpoint of the sender (tomorig replay / acquire)")
       ->capture_default_str();
   cmd->add_flag("--bind", args->bind, "Bind --from instead of connecting (then the sender connects)");
-  cmd->add_flag("--allow-remote", args->allow_remote, "Allow --bind on a non-loopback address");
+  cmd->add_flag("--allow-remote", args->allow_remote, "Allow --bind on a non-loopback address (needs --token)");
+  cmd->add_option("--token", args->token, "Shared secret of the stream (default: $TOMORIG_STREAM_TOKEN); required beyond loopback, both sides alike");
   cmd->add_option("-o,--out", args->recorder.out, "Session file to write (.h5)")->required();
   cmd->add_option("--sets", args->sets, "Stop after this many sets (default: at the sender's end of acquisition, Ctrl-C or --idle-timeout)");
   cmd->add_option("--compression", args->compression, "Frame compression: none | bitshuffle-lz4")
@@ -267,6 +278,9 @@ void add_record_command(CLI::App& root) {
   cmd->add_flag("--overwrite", args->recorder.overwrite, "Replace an existing output file");
   cmd->add_option("--disk-reserve-mb", args->recorder.disk_reserve_mb,
                   "Stop recording cleanly when the disk would have less than this many MB free")
+      ->capture_default_str();
+  cmd->add_option("--max-set-mb", args->recorder.max_set_mb,
+                  "Refuse a first set larger than this many MB of pixels (it would size the session)")
       ->capture_default_str();
   cmd->add_flag("-v,--verbose", args->verbose, "Print a line for every set written");
   cmd->callback([args] { record(*args); });

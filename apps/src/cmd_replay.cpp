@@ -51,6 +51,7 @@ struct ReplayOptions {
   std::string to = "tcp://127.0.0.1:5555";
   bool connect = false;
   bool allow_remote = false;
+  std::string token;
   std::string rate = "recorded";
   bool loop = false;
   std::string sets;
@@ -115,6 +116,7 @@ void replay(const ReplayOptions& opt) {
   zmq::context_t context(1);
   stream::SocketOptions socket;
   socket.endpoint = {opt.to, !opt.connect, opt.allow_remote};
+  socket.endpoint.token = opt.token;
   socket.timeout = duration_cast<std::chrono::milliseconds>(duration<double>(opt.timeout_s));
   auto sender = std::make_unique<stream::FrameSender>(context, socket);
   // The first line names the real endpoint (a "*" port resolved), for scripts and tests.
@@ -202,7 +204,8 @@ void add_replay_command(CLI::App& root) {
                   "free port, printed on stderr")
       ->capture_default_str();
   cmd->add_flag("--connect", opt->connect, "Connect to a receiver that binds (e.g. 'tomorig record --bind')");
-  cmd->add_flag("--allow-remote", opt->allow_remote, "Allow binding to a non-loopback address");
+  cmd->add_flag("--allow-remote", opt->allow_remote, "Allow binding to a non-loopback address (needs --token)");
+  cmd->add_option("--token", opt->token, "Shared secret of the stream (default: $TOMORIG_STREAM_TOKEN); required beyond loopback, both sides alike");
   cmd->add_option("--rate", opt->rate, "recorded (trigger timestamps) | max | a rate in Hz")->capture_default_str();
   cmd->add_flag("--loop", opt->loop, "Start over after the last set, until Ctrl-C");
   cmd->add_option("--sets", opt->sets, "Sets to send: A:B (A to B-1), A:, :B or A");

@@ -7,6 +7,7 @@
 #include "tomorig/core/error.h"
 #include "tomorig/core/version.h"
 #include "tomorig/rig/record_layout.h"
+#include "tomorig/storage/session_cameras.h"
 
 namespace tomorig::rig {
 namespace {
@@ -24,6 +25,24 @@ void RecorderOptions::validate() const {
   if (out.empty()) throw bad_input("the recorder has no output file: give one with -o/--out");
   if (!(disk_reserve_mb >= 0.0))
     throw bad_input(fmt::format("--disk-reserve-mb {:g} is invalid: it must be >= 0", disk_reserve_mb));
+  if (!(max_set_mb > 0.0))
+    throw bad_input(fmt::format("--max-set-mb {:g} is invalid: it must be > 0", max_set_mb));
+}
+
+std::string why_not_recordable(const std::vector<storage::SessionCamera>& cameras, const RecorderOptions& options) {
+  try {
+    storage::check_session_cameras(cameras, options.out);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  double set_bytes = 0.0;  // the sizes are bounded now, so this cannot overflow
+  for (const auto& cam : cameras)
+    set_bytes += 2.0 * static_cast<double>(cam.width) * static_cast<double>(cam.height) *
+                 static_cast<double>(bytes_per_sample(sample_type_of(cam.pixel_format)));
+  if (set_bytes > options.max_set_mb * 1e6)
+    return fmt::format("a set of its {} cameras takes {:.1f} MB, more than the recorder takes (--max-set-mb {:g})",
+                       cameras.size(), set_bytes / 1e6, options.max_set_mb);
+  return {};
 }
 
 std::string RecorderReport::brief() const {
@@ -83,7 +102,8 @@ Recorder::Outcome Recorder::add(const FrameSet& set, const storage::TruthSet* tr
   if (!writer_) {
     auto cameras = options_.cameras.empty() ? cameras_from_set(set, reason)
                                             : complete_announced_cameras(options_.cameras, set, reason);
-    if (!cameras) {
+    if (cameras) reason = why_not_recordable(*cameras, options_);
+    if (!cameras || !reason.empty()) {
       ++report_.refused;
       if (why != nullptr) *why = "it cannot start the session: " + reason;
       return Outcome::refused;

@@ -21,7 +21,7 @@ trigger::Pacing parse_pace(const std::string& text) {
 void check_status_endpoint(const std::string& address) {
   if (address.empty() || address == "none") return;
   try {
-    stream::check_endpoint({address, /*bind=*/true, /*allow_remote=*/true});  // the address's form only
+    stream::check_address_form(address);
   } catch (const Error& e) {
     throw bad_input(fmt::format("--status: {}", e.what()));
   }

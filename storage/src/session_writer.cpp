@@ -28,6 +28,7 @@
 #include "tomorig/core/camera_id.h"
 #include "tomorig/core/error.h"
 #include "tomorig/core/version.h"
+#include "tomorig/storage/session_cameras.h"
 #include "tomorig/storage/session_file.h"
 #include "utc_time.h"
 
@@ -40,7 +41,9 @@ void check_object_name(const std::string& id, const std::string& what, const fs:
   require_valid_camera_id(id, fmt::format("session '{}', {}", file.string(), what));
 }
 
-void check_cameras(const std::vector<SessionCamera>& cameras, const fs::path& file) {
+}  // namespace
+
+void check_session_cameras(const std::vector<SessionCamera>& cameras, const fs::path& file) {
   if (cameras.empty()) throw bad_input(fmt::format("session '{}' needs at least one camera", file.string()));
   if (cameras.size() > layout::kMaxCameras)
     throw bad_input(fmt::format("session '{}' would have {} cameras; a session holds at most {}", file.string(),
@@ -62,6 +65,8 @@ void check_cameras(const std::vector<SessionCamera>& cameras, const fs::path& fi
                                   layout::kMaxFrameBytes));
   }
 }
+
+namespace {
 
 
 // A "<path>.partial" that exists before this writer starts was left by a writer that never
@@ -162,7 +167,7 @@ struct SessionWriter::Impl {
 
 SessionWriter::Impl::Impl(const fs::path& path, const SessionInfo& info, const SessionWriterOptions& opts)
     : partial(fs::path(path).concat(".partial")), final_path(path), options(opts) {
-  check_cameras(info.cameras, final_path);
+  check_session_cameras(info.cameras, final_path);
   check_output_path(final_path, options.overwrite, "session");
   lock = OutputLock::acquire(final_path, "session");
   std::error_code ec;

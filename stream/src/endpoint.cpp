@@ -1,6 +1,9 @@
 #include "tomorig/stream/endpoint.h"
 
+#include <cstdlib>
 #include <string>
+
+#include <fmt/core.h>
 
 #include "tomorig/core/error.h"
 
@@ -43,19 +46,43 @@ bool is_local_address(std::string_view address) {
   return false;
 }
 
-void check_endpoint(const Endpoint& endpoint) {
-  const std::string& a = endpoint.address;
+std::string stream_token(const Endpoint& endpoint) {
+  if (!endpoint.token.empty()) return endpoint.token;
+  const char* env = std::getenv(kStreamTokenVariable);
+  return env != nullptr ? std::string(env) : std::string();
+}
+
+std::string zmq_address(std::string_view address) {
+  constexpr std::string_view kLocalhost = "tcp://localhost:";
+  if (starts_with(address, kLocalhost)) return "tcp://127.0.0.1:" + std::string(address.substr(kLocalhost.size()));
+  return std::string(address);
+}
+
+void check_address_form(std::string_view a) {
   const bool known_transport = starts_with(a, "tcp://") || starts_with(a, "ipc://") || starts_with(a, "inproc://");
   const std::size_t sep = a.find("://");
   if (!known_transport || sep + 3 >= a.size() || (starts_with(a, "tcp://") && tcp_host(a.substr(6)).empty()))
-    throw bad_input("stream endpoint '" + a +
+    throw bad_input("stream endpoint '" + std::string(a) +
                     "' is not a ZeroMQ address; use tcp://HOST:PORT (e.g. tcp://127.0.0.1:5555), ipc://PATH or "
                     "inproc://NAME");
-  if (endpoint.bind && !endpoint.allow_remote && !is_local_address(a))
+}
+
+void check_endpoint(const Endpoint& endpoint) {
+  const std::string& a = endpoint.address;
+  check_address_form(a);
+  const bool remote = !is_local_address(a);
+  if (endpoint.bind && !endpoint.allow_remote && remote)
     throw bad_input("refusing to bind stream endpoint '" + a +
                     "': it would accept connections from other hosts. Bind to loopback (e.g. tcp://127.0.0.1:" +
-                    "PORT), or set allow_remote = true for this endpoint (--allow-remote on the command line) to expose "
-                    "the stream on purpose");
+                    "PORT), or give " + endpoint.allow_remote_option +
+                    " (with a shared token: --token or " + kStreamTokenVariable + ") to expose the stream on purpose");
+  const std::string token = stream_token(endpoint);
+  if (remote && token.empty())
+    throw bad_input(fmt::format("stream endpoint '{}' is not on this host, so {} needs a shared token: give the same "
+                                "secret to both sides with --token or the {} environment variable",
+                                a, endpoint.bind ? "binding it" : "connecting to it", kStreamTokenVariable));
+  if (token.size() > 255)
+    throw bad_input(fmt::format("the stream token is {} bytes; use 1 to 255 bytes", token.size()));
 }
 
 }  // namespace tomorig::stream

@@ -1,5 +1,7 @@
 #include "tomorig/stream/frame_receiver.h"
 
+#include <cstdint>
+
 #include "multipart.h"
 #include "socket_setup.h"
 #include "tomorig/core/error.h"
@@ -50,8 +52,12 @@ std::optional<StreamMessage> FrameReceiver::receive_message() {
     return message;
   }
   // A replay loop restarting at 0 is not a loss; only forward jumps are.
-  if (impl_->last_index && set->set_index > *impl_->last_index + 1)
-    impl_->stats.sets_missing += set->set_index - *impl_->last_index - 1;
+  // Saturating: a damaged but well-formed index can jump by almost 2^64.
+  if (impl_->last_index && set->set_index > *impl_->last_index + 1) {
+    const std::uint64_t gap = set->set_index - *impl_->last_index - 1;
+    std::uint64_t& missing = impl_->stats.sets_missing;
+    missing = gap > UINT64_MAX - missing ? UINT64_MAX : missing + gap;
+  }
   impl_->last_index = set->set_index;
   ++impl_->stats.sets_received;
   return message;

@@ -1,5 +1,7 @@
 #include "tomorig/stream/frame_sender.h"
 
+#include <cstring>
+
 #include <fmt/format.h>
 
 #include "socket_setup.h"
@@ -8,8 +10,13 @@
 
 namespace tomorig::stream {
 
+namespace {
+std::atomic<std::uint64_t> g_monitors{0};  // unique inproc names for the sockets' monitors
+}  // namespace
+
 struct FrameSender::Impl {
   detail::OpenedSocket opened;
+  int receivers = 0;      // connected receivers seen on `monitor`
   std::atomic<std::uint64_t> sets_sent{0};
   std::atomic<std::uint64_t> bytes_sent{0};
   std::atomic<std::uint64_t> blocked_sends{0};
@@ -19,11 +26,40 @@ struct FrameSender::Impl {
 FrameSender::FrameSender(zmq::context_t& context, SocketOptions options)
     : impl_(std::make_unique<Impl>()) {
   // Closing waits up to one timeout so sets already queued still reach the receiver.
-  impl_->opened = detail::open_socket(context, zmq::socket_type::push, options, options.timeout,
-                                      detail::lossless_send_buffer_bytes());
+  const std::string address = fmt::format("inproc://tomorig-sender-monitor-{}", g_monitors.fetch_add(1));
+  impl_->opened = detail::open_socket(context, zmq::socket_type::push, options, options.linger.value_or(options.timeout),
+                                      detail::lossless_send_buffer_bytes(), address);
 }
 
-FrameSender::~FrameSender() = default;
+FrameSender::~FrameSender() {
+  if (impl_) zmq_socket_monitor(impl_->opened.socket.handle(), nullptr, 0);
+}
+
+bool FrameSender::wait_for_receiver(std::chrono::milliseconds timeout) {
+  // Each event is two parts: 6 bytes (u16 event, u32 value), then the endpoint.
+  auto drain = [&] {
+    zmq::message_t part;
+    while (impl_->opened.monitor.recv(part, zmq::recv_flags::dontwait)) {
+      std::uint16_t event = 0;
+      if (part.size() >= sizeof event) std::memcpy(&event, part.data(), sizeof event);
+      while (part.more() && impl_->opened.monitor.recv(part, zmq::recv_flags::dontwait)) {
+      }
+      if (event == ZMQ_EVENT_HANDSHAKE_SUCCEEDED) ++impl_->receivers;
+      // A disconnect is also reported for a connection that never completed its handshake.
+      if (event == ZMQ_EVENT_DISCONNECTED && impl_->receivers > 0) --impl_->receivers;
+    }
+  };
+  drain();
+  if (impl_->receivers > 0 || timeout.count() <= 0) return impl_->receivers > 0;
+  zmq::pollitem_t item{impl_->opened.monitor.handle(), 0, ZMQ_POLLIN, 0};
+  try {
+    zmq::poll(&item, 1, timeout);
+  } catch (const zmq::error_t& e) {
+    if (e.num() != EINTR) throw;  // a signal: the caller looks at it and may wait again
+  }
+  drain();
+  return impl_->receivers > 0;
+}
 
 bool FrameSender::send(const FrameSet& set) {
   std::vector<zmq::message_t> parts = encode_frame_set(set);

@@ -4,6 +4,8 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <string_view>
+#include <unordered_set>
 
 #include <fmt/format.h>
 
@@ -235,10 +237,12 @@ FrameSet decode_frame_set(std::vector<zmq::message_t>&& parts) {
   if (r.offset() != table_start + table_bytes)
     throw bad_input(fmt::format("camera id table declares {} bytes but its ids fill {}", table_bytes,
                                 r.offset() - table_start));
-  for (std::size_t i = 0; i < set.cameras.size(); ++i)
-    for (std::size_t j = 0; j < i; ++j)
-      if (set.cameras[i].camera_id == set.cameras[j].camera_id)
-        throw bad_input("wire header names camera '" + set.cameras[i].camera_id + "' twice");
+  // A set may declare 32767 cameras: a pairwise comparison would take seconds for one message.
+  std::unordered_set<std::string_view> ids;
+  ids.reserve(set.cameras.size());
+  for (const auto& cam : set.cameras)
+    if (!ids.insert(cam.camera_id).second)
+      throw bad_input("wire header names camera '" + cam.camera_id + "' twice");
 
   std::vector<bool> seen(frame_count, false);
   for (std::size_t i = 0; i < frame_count; ++i) {

@@ -13,63 +13,12 @@
 #include "child_process.h"
 #include "cli_runner.h"
 #include "tomorig/storage/session_file.h"
+#include "scripted_sender.h"
 #include "tomorig/stream/frame_sender.h"
 
 namespace tomorig::testing {
 namespace {
 using namespace std::chrono_literals;
-
-constexpr int kWidth = 16;
-constexpr int kHeight = 8;
-
-FrameSet small_set(std::uint64_t index) {
-  FrameSet set;
-  set.set_index = index;
-  set.trigger_index = 100 + index;
-  set.trigger_timestamp_ns = 1'000'000'000 + static_cast<std::int64_t>(index) * 100'000'000;
-  set.dt_ns = 50'000;
-  for (int c = 0; c < 2; ++c) {
-    CameraFrames cam;
-    cam.camera_id = "cam" + std::to_string(c);
-    for (Frame* f : {&cam.a, &cam.b}) {
-      f->image = Image::allocate(kWidth, kHeight, SampleType::u16);
-      for (int y = 0; y < kHeight; ++y)
-        for (int x = 0; x < kWidth; ++x)
-          f->image.at<std::uint16_t>(x, y) = static_cast<std::uint16_t>(index * 1000 + c * 100 + x + y);
-      f->timestamp_ns = set.trigger_timestamp_ns;
-    }
-    set.cameras.push_back(std::move(cam));
-  }
-  return set;
-}
-
-stream::SessionStart small_start(std::uint64_t id) {
-  stream::SessionStart start;
-  start.session_id = id;
-  start.info.rig_config_toml = "name = \"scripted\"\n";
-  start.info.software_version = "scripted-sender";
-  start.info.cameras = {{"cam0", kWidth, kHeight, PixelFormat::Mono16, 5.5},
-                        {"cam1", kWidth, kHeight, PixelFormat::Mono16, 5.5}};
-  return start;
-}
-
-// A sender bound to a free loopback port, as acquire and replay bind.
-class ScriptedSender {
- public:
-  ScriptedSender() : sender_(context_, options()) {}
-  stream::FrameSender& operator*() { return sender_; }
-  stream::FrameSender* operator->() { return &sender_; }
-
- private:
-  static stream::SocketOptions options() {
-    stream::SocketOptions o;
-    o.endpoint.address = "tcp://127.0.0.1:*";
-    o.timeout = 30s;  // the first send waits for record to connect
-    return o;
-  }
-  zmq::context_t context_;
-  stream::FrameSender sender_;
-};
 
 class RecordSession : public ::testing::Test {
  protected:

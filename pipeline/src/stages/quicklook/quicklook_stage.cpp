@@ -68,6 +68,7 @@ class QuickLookStage final : public Stage {
     if (!publish_.empty() && publish_ != "none") {
       stream::SocketOptions options = stream::preview_socket_options(publish_);
       options.endpoint.allow_remote = allow_remote_;
+      options.endpoint.allow_remote_option = "the stage key allow_remote=true (--stage quicklook:allow_remote=true)";
       publisher_ = std::make_unique<stream::PreviewPublisher>(context_, options);
     }
   }

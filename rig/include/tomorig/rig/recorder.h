@@ -31,6 +31,10 @@ struct RecorderOptions {
   // Stop cleanly (Outcome::stopped, the session complete) when the disk would keep less than
   // this many MB free after the next set.
   double disk_reserve_mb = 64.0;
+  // The largest set the recorder takes, in MB of pixels (both frames of every camera): a set
+  // that would start a session past it is refused, so one absurd message cannot make the
+  // recorder create a file sized for it. Later sets must match the first one's cameras.
+  double max_set_mb = 4096.0;
   // The session's cameras, when known: then the file is created by the constructor. A camera of
   // width or height 0 gets its size from the first set (its id and pixel pitch are kept); empty:
   // the first set that can define them says which cameras there are.
@@ -49,6 +53,11 @@ struct RecorderOptions {
 // "none" or "bitshuffle-lz4"; bad_input naming --compression otherwise.
 storage::Compression parse_compression_option(const std::string& text);
 
+// Why a session of `cameras` cannot be recorded with `options`: more cameras than a session
+// holds, an id the camera-id rule refuses, a duplicate id, a size of 0 or past 65536, a set
+// past options.max_set_mb. Empty if it can. Touches no file; quick for any list.
+std::string why_not_recordable(const std::vector<storage::SessionCamera>& cameras, const RecorderOptions& options);
+
 // What the Recorder's constructor checks first, for callers that must refuse a bad output
 // before building anything else: validates, refuses an existing `out` without `overwrite`,
 // creates the output folder. Throws tomorig::Error (bad_input) naming -o/--out.
@@ -58,7 +67,7 @@ struct RecorderReport {
   std::filesystem::path out;
   std::uint64_t written = 0;  // sets in the session
   std::uint64_t bytes = 0;    // pixel bytes of the sets written (before compression)
-  std::uint64_t refused = 0;  // sets that could not start the session or did not match it
+  std::uint64_t refused = 0;  // sets that could not start the session (why_not_recordable) or did not match it
   std::uint64_t quicklook_rows = 0;      // quick-look records stored (add_quicklook)
   std::uint64_t quicklook_failures = 0;  // quick-look records the file did not take
   std::string disk_full;      // why the disk stopped the recording; empty if it did not

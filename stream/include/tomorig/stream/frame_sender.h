@@ -4,6 +4,7 @@
 // frames being dropped. A send that finds no room within the timeout reports it and sends
 // nothing, so the caller still holds the set and decides (retry, or stop and say why).
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -44,6 +45,12 @@ class FrameSender {
   bool send(const SessionStart& start);
   bool send(const SetTruth& truth);
   bool send(const SessionEnd& end);
+
+  // True once a receiver has completed its connection (handshake, and token if any), waiting
+  // up to `timeout` for one. A connecting PUSH socket queues messages before any receiver is
+  // there, so a successful send does not tell that a receiver exists; this does. From the
+  // sending thread only.
+  bool wait_for_receiver(std::chrono::milliseconds timeout);
 
   // The address as bound (tcp://127.0.0.1:* resolved to the real port) or as connected.
   const std::string& endpoint() const;
