@@ -28,6 +28,7 @@
 #include "tomorig/processing/calibration/calibration_file.h"
 #include "tomorig/processing/calibration/fit_camera_model.h"
 #include "tomorig/processing/calibration/traverse_correction.h"
+#include "tomorig/storage/output_path.h"
 
 namespace tomorig::app {
 
@@ -67,6 +68,7 @@ struct CalibrateArgs {
   std::vector<std::string> camera_sizes;
   int max_iterations = calibration::FitOptions{}.max_iterations;
   std::string out;
+  bool overwrite = false;
   bool json = false;
 };
 
@@ -238,6 +240,8 @@ Inputs read_inputs(const CalibrateArgs& args) {
 }
 
 void run(const CalibrateArgs& args) {
+  // Before any fit: an existing calibration is never replaced without --overwrite.
+  storage::check_output_path(args.out, args.overwrite, "calibration");
   const std::vector<std::string> models = parse_models(args.models);
   const std::string stored = args.store.empty() ? models.back() : args.store;
   if (std::find(models.begin(), models.end(), stored) == models.end())
@@ -347,6 +351,7 @@ void add_calibrate_command(CLI::App& root) {
                   "Levenberg-Marquardt iterations per fit; a fit that does not converge within them fails (exit 1)")
       ->capture_default_str();
   cmd->add_option("-o,--out", args->out, "Calibration file to write (.toml)")->required();
+  cmd->add_flag("--overwrite", args->overwrite, "Replace the calibration file if it exists");
   cmd->add_flag("--json", args->json, "Print the report as one JSON object");
   cmd->callback([args] { run(*args); });
 }

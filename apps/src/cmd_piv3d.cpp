@@ -13,6 +13,7 @@
 #include "commands.h"
 #include "tomorig/pipeline/correlation_args.h"
 #include "tomorig/core/error.h"
+#include "tomorig/storage/output_path.h"
 #include "tomorig/storage/results_file.h"
 #include "tomorig/storage/volume_file.h"
 
@@ -46,6 +47,9 @@ std::int64_t recorded_dt_ns(const storage::VolumeFileReader& file) {
 }
 
 void run(const Piv3dArgs& args) {
+  // Before anything is read: an existing results file (perhaps a whole `process` run) is never
+  // replaced without --overwrite.
+  storage::check_output_path(args.out, args.overwrite, "results");
   const storage::VolumeFileReader file_a(args.volumes);
   std::unique_ptr<storage::VolumeFileReader> other;
   if (!args.volume_b.empty()) other = std::make_unique<storage::VolumeFileReader>(args.volume_b);
@@ -104,7 +108,7 @@ void run(const Piv3dArgs& args) {
                                  .session_identity = identity,
                                  .parameters_json = parameters.dump(),
                                  .voxel_size_mm = ga.voxel_size},
-                                {.overwrite = true});
+                                {.overwrite = args.overwrite});
   writer.add(result);
   writer.close();
   const nlohmann::json summary = {{"out", args.out},
@@ -128,7 +132,8 @@ void add_piv3d_command(CLI::App& root) {
   cmd->add_option("--volume-b", args->volume_b, "Second volume file holding volume b (default: --volumes)");
   cmd->add_option("--a", args->name_a, "Name of the first volume")->capture_default_str();
   cmd->add_option("--b", args->name_b, "Name of the second volume")->capture_default_str();
-  cmd->add_option("-o,--out", args->out, "Results file to write (.h5, replaced if present)")->required();
+  cmd->add_option("-o,--out", args->out, "Results file to write (.h5)")->required();
+  cmd->add_flag("--overwrite", args->overwrite, "Replace the results file if it exists");
   cmd->add_option("--dt-ns", args->dt_ns, "Pulse separation in ns (default: the one recorded in the volume file)");
   add_correlation_flags(*cmd, args->correlation);
   cmd->add_option("--threads", args->threads, "OpenMP threads (0: all cores)")->capture_default_str();

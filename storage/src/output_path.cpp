@@ -1,4 +1,4 @@
-#include "output_path.h"
+#include "tomorig/storage/output_path.h"
 
 #include <fmt/format.h>
 

@@ -21,7 +21,7 @@
 #include "h5_error.h"
 #include "h5_handle.h"
 #include "output_lock.h"
-#include "output_path.h"
+#include "tomorig/storage/output_path.h"
 #include "partial_file.h"
 #include "quicklook_rows.h"
 #include "session_layout.h"

@@ -14,7 +14,7 @@
 #include "h5_datasets.h"
 #include "h5_error.h"
 #include "h5_handle.h"
-#include "output_path.h"
+#include "tomorig/storage/output_path.h"
 #include "output_lock.h"
 #include "partial_file.h"
 #include "tomorig/core/error.h"

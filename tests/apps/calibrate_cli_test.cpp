@@ -116,6 +116,23 @@ TEST_F(CalibrateCli, StoreOptionAndTextReportAndPerCameraSizes) {
   EXPECT_LT(std::hypot(fitted.x - truth.x, fitted.y - truth.y), 1e-3);
 }
 
+// Issue 23: an existing calibration was replaced without a word. Now it is refused before any
+// fit, the file untouched, unless --overwrite is given.
+TEST_F(CalibrateCli, AnExistingCalibrationIsReplacedOnlyWithOverwrite) {
+  const std::string points = write_points(csv_rows(stereo_pair(), {-2, 0, 2}, 10, 6));
+  const auto out = dir_ / "calib.toml";
+  write_file(out, "# the calibration of yesterday's run\n");
+  const CliResult refused = run_tomorig("calibrate --points " + points + " --models pinhole --image-size 512,512 -o " + shell_quoted(out.string()));
+  EXPECT_EQ(refused.exit_code, 2) << refused.err;
+  EXPECT_NE(refused.err.find("already exists"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("--overwrite"), std::string::npos) << refused.err;
+  EXPECT_EQ(read_text_file(out), "# the calibration of yesterday's run\n");
+  const CliResult replaced = run_tomorig("calibrate --points " + points + " --models pinhole --image-size 512,512 --overwrite -o " +
+                                         shell_quoted(out.string()));
+  ASSERT_EQ(replaced.exit_code, 0) << replaced.err;
+  EXPECT_EQ(calibration::load_calibration(out.string()).size(), 2u);
+}
+
 TEST_F(CalibrateCli, BadInputIsAnErrorNamingTheCameraOrTheLine) {
   const auto cameras = stereo_pair();
   const std::string good = csv_rows(cameras, {-2, 0, 2}, 10, 6);

@@ -346,6 +346,19 @@ TEST_F(ProcessCli, Piv3dCorrelatesTheVolumesOfReconstruct) {
   for (const VectorStatus st : set.field.status) valid += st == VectorStatus::valid;
   EXPECT_GT(static_cast<double>(valid) / set.field.count(), 0.6);  // 5 x 5 x 9 nodes, most on a face
 
+  // Issue 23: piv3d replaced an existing results file (a whole process run) without a word.
+  const std::string kept = read_text_file(out);
+  const CliResult again = run_tomorig("piv3d --volumes " + shell_quoted(volumes.string()) + " " + kCorrelation +
+                                      " -o " + shell_quoted(out.string()));
+  EXPECT_EQ(again.exit_code, 2) << again.err;
+  EXPECT_NE(again.err.find("already exists"), std::string::npos) << again.err;
+  EXPECT_NE(again.err.find("--overwrite"), std::string::npos) << again.err;
+  EXPECT_EQ(read_text_file(out), kept);
+  const CliResult replaced = run_tomorig("piv3d --volumes " + shell_quoted(volumes.string()) + " " + kCorrelation +
+                                         " --overwrite -o " + shell_quoted(out.string()));
+  EXPECT_EQ(replaced.exit_code, 0) << replaced.err;
+  EXPECT_EQ(storage::ResultsReader(out).set_indices().size(), 1u);
+
   const CliResult too_big = run_tomorig("piv3d --volumes " + shell_quoted(volumes.string()) +
                                         " --window 256,32,32 -o " + shell_quoted((*dir_ / "x.h5").string()));
   EXPECT_EQ(too_big.exit_code, 2) << too_big.err;

@@ -1,6 +1,7 @@
 #pragma once
 // Checks made before a writer creates anything, so that a bad output path fails at once with
-// a message naming the path, and never after minutes of work.
+// a message naming the path, and never after minutes of work. Commands whose output is not an
+// HDF5 file of storage (a calibration file) call it before their work starts, too.
 #include <filesystem>
 #include <string_view>
 
