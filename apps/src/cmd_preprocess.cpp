@@ -21,6 +21,7 @@
 #include "tomorig/processing/preprocess/chain_spec.h"
 #include "tomorig/processing/preprocess/image_chain.h"
 #include "tomorig/processing/preprocess/sequence_image.h"
+#include "tomorig/storage/output_path.h"
 #include "tomorig/storage/session_file.h"
 
 namespace tomorig::app {
@@ -72,6 +73,8 @@ fs::path resolve(const std::string& file, const fs::path& chain_path) {
 }
 
 void run(const PreprocessArgs& args) {
+  // Before the sequence passes, which can take minutes: an existing output is refused now.
+  storage::check_output_path(args.out, args.overwrite, "session");
   const preprocess::ChainSpec spec = preprocess::read_chain_file(args.chain);
   const storage::SessionReader session(args.session);
   const SetRange range = parse_sets(args.sets, session.set_count());

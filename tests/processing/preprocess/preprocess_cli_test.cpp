@@ -73,6 +73,22 @@ TEST_F(PreprocessCli, WritesAReadableSessionWithTheSameSets) {
 // The pixels themselves, seen through the CLI only (this suite does not link storage): a
 // clip above every value must leave all-zero frames, which a flat-field step then refuses as
 // a dark bright field, while the unprocessed session is accepted as one.
+// Issue 23: an existing output was found only after the sequence passes (minutes on a long
+// session). Now it is refused before the first pass, and kept.
+TEST_F(PreprocessCli, AnExistingOutputIsRefusedBeforeAnyPass) {
+  const auto chain = dir_ / "chain.toml";
+  write_text(chain, "[[preprocess.steps]]\nkind = \"subtract_minimum\"\n");
+  const auto out = dir_ / "p.h5";
+  write_text(out, "an earlier output");
+  const CliResult r = run_tomorig("preprocess --session " + shell_quoted(session_.string()) + " --chain " +
+                                  shell_quoted(chain.string()) + " -o " + shell_quoted(out.string()));
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("already exists"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--overwrite"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("pass 1/"), std::string::npos) << r.err;
+  EXPECT_EQ(read_text_file(out), "an earlier output");
+}
+
 TEST_F(PreprocessCli, ClipAboveEveryValueLeavesZeroFrames) {
   const auto clip = dir_ / "clip.toml";
   write_text(clip, "[[preprocess.steps]]\nkind = \"clip\"\nlevel = 100000\n");
