@@ -110,6 +110,13 @@ void write_doubles_attr(hid_t object, const char* name, std::span<const double> 
   write_attr(object, name, H5T_IEEE_F64LE, space.get(), H5T_NATIVE_DOUBLE, values.data(), where);
 }
 
+void write_int32s_attr(hid_t object, const char* name, std::span<const std::int32_t> values,
+                       std::span<const hsize_t> dims, std::string_view where) {
+  Dataspace space(check(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), "cannot create",
+                        attr_name(name, where)));
+  write_attr(object, name, H5T_STD_I32LE, space.get(), H5T_NATIVE_INT32, values.data(), where);
+}
+
 bool has_attr(hid_t object, const char* name) { return H5Aexists(object, name) > 0; }
 
 std::string read_string_attr(hid_t object, const char* name, std::string_view where) {

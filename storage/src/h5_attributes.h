@@ -28,6 +28,11 @@ void write_double_attr(hid_t object, const char* name, double value, std::string
 void write_doubles_attr(hid_t object, const char* name, std::span<const double> values,
                         std::span<const hsize_t> dims, std::string_view where);
 
+// An int32 array attribute (counts such as a grid's nodes: h5py gives an integer array, so
+// `reshape(nz, ny, nx, 3)` takes it as is).
+void write_int32s_attr(hid_t object, const char* name, std::span<const std::int32_t> values,
+                       std::span<const hsize_t> dims, std::string_view where);
+
 bool has_attr(hid_t object, const char* name);
 // The readers throw h5::Failure naming the attribute and object when it is missing or has
 // the wrong class or size; numeric values are converted by HDF5 from whatever type is stored,

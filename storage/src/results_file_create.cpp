@@ -34,10 +34,12 @@ std::vector<hsize_t> field_dims(const FieldShape& s, hsize_t components) {
 
 void write_node_grid(hid_t object, const FieldShape& s, const std::string& where) {
   const std::array<hsize_t, 1> three{3};
-  const std::array<double, 3> nodes{static_cast<double>(s.nx), static_cast<double>(s.ny), static_cast<double>(s.nz)};
+  // Integers (issue 23: as float64 they broke numpy's reshape); readers accept either.
+  const std::array<std::int32_t, 3> nodes{static_cast<std::int32_t>(s.nx), static_cast<std::int32_t>(s.ny),
+                                          static_cast<std::int32_t>(s.nz)};
   const std::array<double, 3> o{s.origin.x, s.origin.y, s.origin.z};
   const std::array<double, 3> sp{s.spacing.x, s.spacing.y, s.spacing.z};
-  h5::write_doubles_attr(object, layout::kAttrNodes, nodes, three, where);
+  h5::write_int32s_attr(object, layout::kAttrNodes, nodes, three, where);
   h5::write_doubles_attr(object, layout::kAttrOrigin, o, three, where);
   h5::write_doubles_attr(object, layout::kAttrSpacing, sp, three, where);
 }

@@ -89,6 +89,33 @@ TEST(ResultsFile, RoundTripsFieldsFlagsPeaksAndNodePositions) {
   EXPECT_NE(xdmf.find("Dimensions=\"2 3 4 3\""), std::string::npos);
 }
 
+// Issue 23: `nodes` was float64, so numpy's reshape(nz, ny, nx, 3) with it raised a TypeError.
+TEST(ResultsFile, NodeCountsAreIntegersAsAnOutsideToolReadsThem) {
+  TempDir dir;
+  const auto path = dir / "r.h5";
+  {
+    ResultsWriter w(path, info());
+    w.add(set_with(0, 1.0f));
+  }
+  const SetResult expected = ResultsReader(path).read_set(0);
+  for (const char* group : {"/sets", "/statistics"}) {
+    const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    ASSERT_GE(file, 0);
+    const hid_t attr = H5Aopen_by_name(file, group, "nodes", H5P_DEFAULT, H5P_DEFAULT);
+    ASSERT_GE(attr, 0) << group;
+    const hid_t type = H5Aget_type(attr);
+    EXPECT_EQ(H5Tget_class(type), H5T_INTEGER) << group;
+    int nodes[3] = {0, 0, 0};
+    EXPECT_GE(H5Aread(attr, H5T_NATIVE_INT, nodes), 0);
+    EXPECT_EQ(nodes[0], expected.field.nx) << group;
+    EXPECT_EQ(nodes[1], expected.field.ny) << group;
+    EXPECT_EQ(nodes[2], expected.field.nz) << group;
+    H5Tclose(type);
+    H5Aclose(attr);
+    H5Fclose(file);
+  }
+}
+
 TEST(ResultsFile, StatisticsInMetresPerSecond) {
   TempDir dir;
   const auto path = dir / "r.h5";
