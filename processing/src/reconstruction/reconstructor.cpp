@@ -6,6 +6,7 @@
 
 #include "algorithms.h"
 #include "ment.h"
+#include "support.h"
 #include "system_memory.h"
 #include "tomorig/core/error.h"
 
@@ -39,12 +40,6 @@ void ReconstructionOptions::validate() const {
     throw bad_input(fmt::format("reconstruction: memory_limit_mb = {} must be >= 0 (0: MemAvailable)", memory_limit_mb));
 }
 
-namespace {
-double seconds_from(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-}  // namespace
-
 SparseVolume Reconstructor::reconstruct(const ReconstructionInput& input, ReconstructionReport& report) {
   start_ = std::chrono::steady_clock::now();
   observer_seconds_ = 0.0;
@@ -58,7 +53,7 @@ SparseVolume Reconstructor::reconstruct(const ReconstructionInput& input, Recons
   return volume;
 }
 
-double Reconstructor::elapsed_seconds() const { return seconds_from(start_) - observer_seconds_; }
+double Reconstructor::elapsed_seconds() const { return detail::seconds_since(start_) - observer_seconds_; }
 
 void Reconstructor::notify(int iteration, const IterationStats* stats, std::function<SparseVolume()> volume) {
   if (!observer_) return;
@@ -69,7 +64,7 @@ void Reconstructor::notify(int iteration, const IterationStats* stats, std::func
   view.elapsed_seconds = elapsed_seconds();
   view.volume = std::move(volume);
   observer_(view);
-  observer_seconds_ += seconds_from(t0);
+  observer_seconds_ += detail::seconds_since(t0);
 }
 
 std::string algorithm_names() { return "mlos, ment, mart, smart, fmart"; }

@@ -105,5 +105,4 @@ bool record_iteration(ReconstructionReport& report, int iteration, double residu
   return stop_mean_update > 0 && mean_update < stop_mean_update;
 }
 
-
 }  // namespace tomorig::recon::detail
