@@ -18,8 +18,8 @@
 #include "http_options.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
-#include "tomorig/dashboard/dashboard_info.h"
-#include "tomorig/dashboard/live_feed.h"
+#include "tomorig/dashboard/dashboard_server.h"
+#include "tomorig/dashboard/live_dashboard.h"
 #include "tomorig/dashboard/session_view.h"
 #include "tomorig/storage/session_file.h"
 #include "tomorig/pipeline/quicklook_view.h"
@@ -50,32 +50,34 @@ void serve_dashboard(const PreviewArgs& args) {
   std::optional<config::RigConfig> rig;
   if (!args.config_path.empty()) rig = config::load_rig_config(args.config_path);
   const dashboard::DashboardServerOptions server_options = http_server_options(args.http, rig ? &rig->dashboard : nullptr);
-  dashboard::DashboardState state;
-  std::optional<dashboard::LiveFeed> feed;
+  const rig::StopSignalGuard stop;
   if (!args.session.empty()) {
+    dashboard::DashboardState state;
     const storage::SessionReader session(args.session);  // before any thread starts (see SessionReader)
     dashboard::show_session(state, session);
-  } else {
-    state.set_info(dashboard::dashboard_info({.mode = "live",
-                                              .source = args.from,
-                                              .rig = rig ? &*rig : nullptr,
-                                              .snapshots = !server_options.snapshot_folder.empty()}));
+    dashboard::DashboardServer server(state, server_options);
+    fmt::print(stderr, "preview: dashboard on {} showing {} (Ctrl-C ends)\n", server.url(), args.session);
+    std::fflush(stderr);
+    while (!stop.wait_for(std::chrono::seconds(1))) {
+    }
+    server.stop();
+    fmt::print(stderr, "preview: dashboard stopped by {} after {} quick-look messages\n", stop.signal_name(),
+               state.messages());
+    return;
   }
-  const rig::StopSignalGuard stop;
-  if (args.session.empty())
-    feed.emplace(state, dashboard::LiveFeedOptions{
-                            .preview_endpoint = args.from,
-                            .status_endpoint = args.status,
-                            .notice = [](const std::string& text) { fmt::print(stderr, "preview: {}\n", text); }});
-  dashboard::DashboardServer server(state, server_options);
-  fmt::print(stderr, "preview: dashboard on {} showing {} (Ctrl-C ends)\n", server.url(),
-             args.session.empty() ? args.from : args.session);
+  dashboard::LiveDashboard board(
+      {.mode = "live", .source = args.from, .rig = rig ? &*rig : nullptr},
+      {.preview_endpoint = args.from,
+       .status_endpoint = args.status,
+       .notice = [](const std::string& text) { fmt::print(stderr, "preview: {}\n", text); }},
+      server_options);
+  fmt::print(stderr, "preview: dashboard on {} showing {} (Ctrl-C ends)\n", board.url(), args.from);
   std::fflush(stderr);
   while (!stop.wait_for(std::chrono::seconds(1))) {
   }
-  server.stop();
+  board.stop();
   fmt::print(stderr, "preview: dashboard stopped by {} after {} quick-look messages\n", stop.signal_name(),
-             state.messages());
+             board.state().messages());
 }
 
 void watch(PreviewArgs args) {

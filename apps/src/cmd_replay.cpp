@@ -17,10 +17,13 @@
 #include <zmq.hpp>
 
 #include "commands.h"
+#include "http_options.h"
 #include "tomorig/rig/replay_schedule.h"
 #include "tomorig/rig/send_with_retry.h"
 #include "tomorig/rig/stop_signal.h"
 #include "tomorig/core/error.h"
+#include "tomorig/dashboard/live_dashboard.h"
+#include "tomorig/dashboard/session_view.h"
 #include "tomorig/pipeline/quicklook_settings.h"
 #include "tomorig/pipeline/stage_chain.h"
 #include "tomorig/rig/rig_stages.h"
@@ -59,6 +62,8 @@ struct ReplayOptions {
   double wait_s = 60.0;
   std::vector<std::string> preview;  // --preview [ENDPOINT]
   bool preview_given = false;
+  HttpChoices http;  // --http: the dashboard of the replay, fed by its quick-look
+  bool http_given = false;
 };
 
 double seconds_since(Clock::time_point t) { return duration<double>(Clock::now() - t).count(); }
@@ -104,12 +109,26 @@ void replay(const ReplayOptions& opt) {
 
   // --preview: the quick-look stage on every set sent, publishing for `tomorig preview`. It
   // skips sets to stay current, so it never holds the replay back.
+  // --http turns it on at the default endpoint if --preview did not, and serves the dashboard
+  // on it, subscribed like a separate `tomorig preview --http` would be.
   std::optional<pipeline::StageChain> quicklook;
-  if (opt.preview_given) {
+  std::optional<dashboard::LiveDashboard> board;
+  if (opt.preview_given || opt.http_given) {
     const std::string endpoint = pipeline::preview_endpoint(opt.preview);
+    const std::optional<config::RigConfig> rig = dashboard::session_rig(session);
+    const std::optional<dashboard::DashboardServerOptions> http =
+        opt.http_given ? std::optional(http_server_options(opt.http, rig ? &rig->dashboard : nullptr)) : std::nullopt;
     quicklook = pipeline::make_chain(rig::all_stages(), {pipeline::quicklook_stage_spec(endpoint, {})});
     quicklook->begin(pipeline::describe_session(session));
     fmt::print(stderr, "replay: quick-look results on {} (watch: tomorig preview --from {})\n", endpoint, endpoint);
+    if (http) {
+      board.emplace(dashboard::InfoSource{.mode = "live", .source = opt.file, .rig = rig ? &*rig : nullptr},
+                    dashboard::LiveFeedOptions{
+                        .preview_endpoint = endpoint,
+                        .notice = [](const std::string& text) { fmt::print(stderr, "replay: {}\n", text); }},
+                    *http);
+      fmt::print(stderr, "replay: dashboard on {}\n", board->url());
+    }
   }
 
   StopSignalGuard stop;
@@ -218,8 +237,10 @@ void add_replay_command(CLI::App& root) {
                               "without a value {}",
                               stream::kDefaultPreviewEndpoint))
       ->expected(0, 1);
+  add_http_options(*cmd, opt->http);
   cmd->callback([opt, cmd] {
     opt->preview_given = cmd->count("--preview") > 0;
+    opt->http_given = opt->http.given(*cmd);
     replay(*opt);
   });
 }

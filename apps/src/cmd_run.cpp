@@ -13,8 +13,7 @@
 #include "http_options.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
-#include "tomorig/dashboard/dashboard_info.h"
-#include "tomorig/dashboard/live_feed.h"
+#include "tomorig/dashboard/live_dashboard.h"
 #include "tomorig/pipeline/quicklook_settings.h"
 #include "tomorig/stream/preview.h"
 #include "tomorig/rig/rig_run_options.h"
@@ -35,14 +34,6 @@ struct RunArgs {
   bool preview_given = false;
   HttpChoices http;  // --http: the dashboard, fed by the run's quick-look and status streams
   bool http_given = false;
-};
-
-// The dashboard of a run: a subscriber to the run's own quick-look and status streams, as a
-// separate `tomorig preview --http` would be, so it never holds the recorder up.
-struct RunDashboard {
-  dashboard::DashboardState state;
-  std::optional<dashboard::LiveFeed> feed;
-  std::optional<dashboard::DashboardServer> server;
 };
 
 std::filesystem::path default_output_path() {
@@ -80,16 +71,17 @@ void run(const RunArgs& args) {
   std::fflush(stdout);
   if (!runner.status_endpoint().empty()) fmt::print(stderr, "run: status JSON on {}\n", runner.status_endpoint());
   if (!preview.empty()) fmt::print(stderr, "run: quick-look results on {} (watch: tomorig preview --from {})\n", preview, preview);
-  RunDashboard board;
+  // The dashboard subscribes to the run's own quick-look and status streams, as a separate
+  // `tomorig preview --http` would, so it never holds the recorder up.
+  std::optional<dashboard::LiveDashboard> board;
   if (http) {
-    board.state.set_info(dashboard::dashboard_info(
-        {.mode = "live", .source = rig.name, .rig = &rig, .snapshots = !http->snapshot_folder.empty()}));
-    board.feed.emplace(board.state, dashboard::LiveFeedOptions{
-                                        .preview_endpoint = preview,
-                                        .status_endpoint = runner.status_endpoint(),
-                                        .notice = [](const std::string& text) { fmt::print(stderr, "run: {}\n", text); }});
-    board.server.emplace(board.state, *http);
-    fmt::print(stderr, "run: dashboard on {}\n", board.server->url());
+    board.emplace(dashboard::InfoSource{.mode = "live", .source = rig.name, .rig = &rig},
+                  dashboard::LiveFeedOptions{
+                      .preview_endpoint = preview,
+                      .status_endpoint = runner.status_endpoint(),
+                      .notice = [](const std::string& text) { fmt::print(stderr, "run: {}\n", text); }},
+                  *http);
+    fmt::print(stderr, "run: dashboard on {}\n", board->url());
   }
   std::fflush(stderr);
 

@@ -49,6 +49,7 @@ void decode_quicklook(TableReader& root, QuickLookConfig& q) {
   auto r = root.table("quicklook");
   if (!r) return;
   read_optional(*r, "tile_px", q.tile_px, in_closed(8, 1024));
+  read_optional(*r, "detail_tiles", q.detail_tiles, in_closed(1, 65536));
   read_optional(*r, "peak_sigmas", q.peak_sigmas, greater_than(0.0));
   read_range(*r, "ppp", q.ppp);
   read_range(*r, "diameter_px", q.diameter_px);

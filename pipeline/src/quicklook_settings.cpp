@@ -43,6 +43,7 @@ QuickLookSettings quicklook_settings(const config::RigConfig* rig) {
   const config::QuickLookConfig& q = rig->quicklook;
   quicklook::QuickLookOptions& st = s.statistics;
   apply(q.tile_px, st.tile_px);
+  apply(q.detail_tiles, st.detail_tiles);
   apply(q.peak_sigmas, st.peak_sigmas);
   apply(q.ppp, st.targets.ppp);
   apply(q.diameter_px, st.targets.diameter_px);

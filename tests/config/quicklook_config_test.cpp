@@ -19,6 +19,7 @@ std::string rig_with(const std::string& tail) {
 TEST(QuickLookConfig, AbsentKeysStayUnset) {
   const RigConfig rig = parse_rig_config(rig_with(""));
   EXPECT_FALSE(rig.quicklook.tile_px);
+  EXPECT_FALSE(rig.quicklook.detail_tiles);
   EXPECT_FALSE(rig.quicklook.ppp);
   EXPECT_FALSE(rig.quicklook.dt_check.displacement_px);
   EXPECT_FALSE(rig.quicklook.drift.warn_px);
@@ -33,6 +34,7 @@ TEST(QuickLookConfig, EveryKeyIsRead) {
   const RigConfig rig = parse_rig_config(rig_with(R"(
 [quicklook]
 tile_px = 32
+detail_tiles = 64
 peak_sigmas = 4.5
 ppp = [0.01, 0.05]
 diameter_px = [2.5, 3.5]
@@ -60,6 +62,7 @@ ment_iterations = 3
 )"));
   const QuickLookConfig& q = rig.quicklook;
   EXPECT_EQ(q.tile_px, 32);
+  EXPECT_EQ(q.detail_tiles, 64);
   EXPECT_EQ(q.peak_sigmas, 4.5);
   EXPECT_EQ(q.ppp, (std::array<double, 2>{0.01, 0.05}));
   EXPECT_EQ(q.diameter_px, (std::array<double, 2>{2.5, 3.5}));
@@ -95,6 +98,7 @@ void expect_issue(const std::string& tail, const std::string& key, const std::st
 TEST(QuickLookConfig, BadValuesAreNamed) {
   expect_issue("[quicklook]\nppp = [0.08, 0.02]\n", "quicklook.ppp", "ppp =", "low <= high");
   expect_issue("[quicklook]\ntile_px = 4\n", "quicklook.tile_px", "tile_px", "must be in [8, 1024]");
+  expect_issue("[quicklook]\ndetail_tiles = 0\n", "quicklook.detail_tiles", "detail_tiles", "must be in [1, 65536]");
   expect_issue("[quicklook]\nsaturated_fraction_max = 2\n", "quicklook.saturated_fraction_max", "saturated",
                "must be in (0, 1]");
   expect_issue("[quicklook.dt_check]\nwindows = [4, 2.5]\n", "quicklook.dt_check.windows", "windows",

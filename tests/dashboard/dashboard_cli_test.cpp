@@ -109,6 +109,37 @@ TEST_F(DashboardCli, PreviewSessionServesTheStoredHistory) {
   EXPECT_EQ(preview.wait(), 0) << preview.err();
 }
 
+// `tomorig replay --http`: the dashboard of a replayed session, fed by the replay's own quick-look,
+// with the trigger plan of the rig stored in the session.
+TEST_F(DashboardCli, ReplayServesTheDashboardOfTheSetsItSends) {
+  TempDir dir;
+  const fs::path source = dir / "src.h5";
+  ASSERT_EQ(run_tomorig("run --sets 12 --status none -o " + shell_quoted(source.string())).exit_code, 0);
+  TomorigProcess replay({"replay", source.string(), "--to", "tcp://127.0.0.1:*", "--rate", "4", "--preview",
+                         "ipc://" + (dir / "ql").string(), "--http", "127.0.0.1:0"});
+  const int port = dashboard_port(replay);  // printed before the stream's line
+  ASSERT_GT(port, 0) << replay.err();
+  const auto first = replay.wait_for_line("sending on");
+  ASSERT_TRUE(first) << replay.err();
+  const std::string to = first->substr(first->find("sending on ") + 11, first->find(',') - first->find("sending on ") - 11);
+  EventStream page(port);
+  TomorigProcess record({"record", "--from", to, "-o", (dir / "copy.h5").string(), "--idle-timeout", "60"});
+  EXPECT_TRUE(page.wait_for("event: quicklook", 60s)) << page.text().substr(0, 500) << replay.err();
+  httplib::Client client("127.0.0.1", port);
+  const auto state = client.Get("/api/state");
+  ASSERT_TRUE(state);
+  const json now = json::parse(state->body);
+  EXPECT_EQ(now.at("info").at("mode"), "live");
+  EXPECT_EQ(now.at("info").at("source"), source.string());
+  EXPECT_EQ(now.at("info").at("trigger_plan").at("dt_us"), 100.0) << "from the rig stored in the session";
+  ASSERT_EQ(now.at("quicklook").at("cameras").size(), 4u);
+  const json& ppp = now.at("quicklook").at("cameras")[0].at("statistics").at("a").at("particles").at("ppp");
+  EXPECT_NEAR(ppp.at("value").get<double>(), kTruePpp, 0.1 * kTruePpp);
+  ASSERT_EQ(record.wait(), 0) << record.err();
+  ASSERT_EQ(replay.wait(), 0) << replay.err();
+  EXPECT_EQ(storage::SessionReader(dir / "copy.h5").set_count(), 12u);
+}
+
 TEST_F(DashboardCli, BadUseIsRefusedBeforeAnyFile) {
   TempDir dir;
   const fs::path out = dir / "s.h5";

@@ -151,6 +151,7 @@ TEST(QuickLookSettings, RigKeysOverrideTheLibraryDefaultsAndOnlyThose) {
   const config::RigConfig rig = config::parse_rig_config(config::default_rig_toml() + R"(
 [quicklook]
 ppp = [0.03, 0.06]
+detail_tiles = 64
 saturated_fraction_max = 0.002
 [quicklook.dt_check]
 windows = [3, 2]
@@ -169,6 +170,8 @@ binning = 4
   EXPECT_EQ(s.statistics.targets.saturated_fraction.high, 0.002);
   EXPECT_EQ(s.statistics.targets.diameter_px.high, library.targets.diameter_px.high) << "absent: the library's";
   EXPECT_EQ(s.statistics.tile_px, library.tile_px);
+  EXPECT_EQ(s.statistics.detail_tiles, 64);
+  EXPECT_EQ(defaults.statistics.detail_tiles, library.detail_tiles);
   EXPECT_EQ(s.dt_check.windows_x, 3);
   EXPECT_EQ(s.dt_check.windows_y, 2);
   EXPECT_EQ(s.dt_check.displacement_px.high, 9.0);

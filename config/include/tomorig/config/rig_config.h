@@ -129,6 +129,7 @@ struct SimulationConfig {
 // default in one place. Ranges are [low, high] (green); amber bands stay the library's.
 struct QuickLookConfig {
   std::optional<int> tile_px;
+  std::optional<int> detail_tiles;  // tiles sampled for d_tau, autocovariance ppp and focus
   std::optional<double> peak_sigmas;
   std::optional<std::array<double, 2>> ppp, diameter_px, energy_balance;
   std::optional<double> source_density_max, saturated_fraction_max, soft_tile_fraction_max;
