@@ -26,6 +26,16 @@ using detail::GObjectPtr;
 
 // How often the delivery thread checks for stop() and lost frames.
 constexpr std::chrono::microseconds kPopTimeout{50'000};
+// A trigger whose frame is this much later than the camera's usual answer gets one nudge (a
+// register read, see await_answer()); the answer latency is the median of the last few.
+constexpr std::int64_t kNudgeMarginNs = 3'000'000;
+// Only with this much time left before the camera's next trigger: the read waits for its ack.
+constexpr std::int64_t kNudgeGuardNs = 20'000'000;
+constexpr std::size_t kLatenciesKept = 16;
+constexpr std::size_t kLatenciesNeeded = 4;
+// GigE Vision bootstrap register CCP (control channel privilege): reading it changes nothing,
+// and every GigE Vision camera answers it (Aravis's heartbeat reads it too).
+constexpr guint32 kGvControlChannelPrivilege = 0x0A00;
 
 }  // namespace
 
@@ -76,9 +86,15 @@ struct AravisCamera::Impl {
     std::int64_t spacing_ns = 0;         // two_triggers: frame B's trigger after frame A's
   };
   std::mutex trigger_mutex;
-  std::condition_variable trigger_wanted;
+  std::condition_variable trigger_wanted;  // a job queued, a frame arrived, or stop
   std::deque<TriggerJob> trigger_jobs;
   std::thread trigger_thread;
+  // Frames that arrived (any status), when the last one did: the trigger thread's view of
+  // whether its last trigger was answered. Guarded by trigger_mutex.
+  std::uint64_t frames_arrived = 0;
+  std::int64_t last_arrival_ns = 0;
+  std::deque<std::int64_t> answer_latencies;  // trigger thread only: trigger sent -> frame arrived
+  std::atomic<std::uint64_t> nudges{0};
   // Software triggers: which trigger each frame answers, by time (null: frames are counted).
   std::unique_ptr<TriggerMatcher> matcher;
   std::atomic<std::uint64_t> unmatched{0};
@@ -101,6 +117,10 @@ struct AravisCamera::Impl {
   void deliver_loop();
   void deliver(const detail::StreamBuffer& buffer, FrameIdUnwrapper& unwrapper);
   void trigger_loop();
+  void frame_arrived();
+  void await_answer(std::int64_t sent_ns, std::uint64_t arrivals_before, std::optional<std::int64_t> deadline_ns,
+                    bool learn);
+  void nudge();
   bool send_trigger();  // false: the command failed and the camera is marked disconnected
   void trigger_taken();
   void frames_seen(std::uint64_t sequence);
@@ -160,8 +180,76 @@ bool AravisCamera::Impl::send_trigger() {
   return true;
 }
 
+void AravisCamera::Impl::frame_arrived() {
+  {
+    std::lock_guard lock(trigger_mutex);
+    ++frames_arrived;
+    last_arrival_ns = steady_ns();
+  }
+  trigger_wanted.notify_all();
+}
+
+// A GVCP register read: any command makes a camera that polls its control socket look at its
+// state again (see await_answer()); it triggers nothing. Errors are left to the connection
+// watch (a dead camera fails its next trigger or misses the frame timeout).
+void AravisCamera::Impl::nudge() {
+  if (!arv_camera_is_gv_device(camera.get())) return;
+  GErrorSlot error;
+  guint32 value = 0;
+  arv_device_read_register(arv_camera_get_device(camera.get()), kGvControlChannelPrivilege, &value, error.out());
+  ++nudges;
+}
+
+// Waits for the frame of the trigger sent at `sent_ns` (the first frame to arrive after it)
+// until `deadline_ns` (the next trigger of this job), else until the next job is queued or the
+// frame timeout. A camera answers its triggers with a steady latency (a fixed phase of its
+// readout); one whose frame is kNudgeMarginNs later than the median of its last answers gets
+// one register read. Aravis's GigE fake needs it: it looks for a latched software trigger
+// only on its 40 ms grid, and now and then sleeps through a grid line (its poll timeout is
+// computed unsigned, and a clock tick between two reads of the time turns it into 100 ms), so
+// the latched trigger waits for the next packet to arrive: the next trigger, which it then
+// merges with this one (one frame for two triggers: a frame lost), or nothing for 100 ms (a
+// frame far off its trigger). Any GVCP command wakes it; the read makes the frame ~3 ms late
+// instead of lost. For a camera that answered, nothing is sent.
+void AravisCamera::Impl::await_answer(std::int64_t sent_ns, std::uint64_t arrivals_before,
+                                      std::optional<std::int64_t> deadline_ns, bool learn) {
+  std::optional<std::int64_t> nudge_at;
+  if (answer_latencies.size() >= kLatenciesNeeded) {
+    std::vector<std::int64_t> sorted(answer_latencies.begin(), answer_latencies.end());
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+    nudge_at = sent_ns + sorted[sorted.size() / 2] + kNudgeMarginNs;
+  }
+  const std::int64_t cap = deadline_ns ? *deadline_ns : sent_ns + std::chrono::nanoseconds(options.frame_timeout).count();
+  bool nudged = false;
+  std::unique_lock lock(trigger_mutex);
+  auto answered = [&] { return frames_arrived > arrivals_before; };
+  auto next_job_waits = [&] { return !deadline_ns && !trigger_jobs.empty(); };
+  while (running && !disconnected && !answered() && !next_job_waits()) {
+    const std::int64_t now = steady_ns();
+    if (now >= cap) break;
+    if (nudge_at && !nudged && now >= *nudge_at) {
+      nudged = true;
+      if (cap - now > kNudgeGuardNs) {
+        lock.unlock();
+        nudge();
+        lock.lock();
+      }
+      continue;
+    }
+    const std::int64_t wake = nudge_at && !nudged ? std::min(cap, *nudge_at) : cap;
+    trigger_wanted.wait_until(lock, std::chrono::steady_clock::time_point(std::chrono::nanoseconds(wake)),
+                              [&] { return !running || answered() || next_job_waits(); });
+  }
+  // Latencies of nudged answers would teach the nudge's own delay.
+  if (learn && !nudged && answered() && last_arrival_ns >= sent_ns) {
+    answer_latencies.push_back(last_arrival_ns - sent_ns);
+    if (answer_latencies.size() > kLatenciesKept) answer_latencies.pop_front();
+  }
+}
+
 // One job per trigger event: frame A's trigger, and for two_triggers frame B's, spaced from
 // when A's was really sent (not when it was asked for), so a busy host delays both alike.
+// Between triggers the thread watches for each trigger's frame (await_answer()).
 void AravisCamera::Impl::trigger_loop() {
   for (;;) {
     TriggerJob job;
@@ -174,15 +262,25 @@ void AravisCamera::Impl::trigger_loop() {
     }
     const int triggers = job.event && options.frame_mode == config::FrameMode::two_triggers ? 2 : 1;
     std::int64_t frame_a_sent = 0;
+    std::int64_t sent = 0;
+    std::uint64_t arrivals = 0;
     for (int k = 0; k < triggers && !disconnected && running; ++k) {
-      if (k == 1)
+      if (k == 1) {
+        await_answer(sent, arrivals, frame_a_sent + job.spacing_ns, true);
         std::this_thread::sleep_until(std::chrono::steady_clock::time_point(std::chrono::nanoseconds(frame_a_sent + job.spacing_ns)));
-      const std::int64_t now = steady_ns();
-      if (k == 0) frame_a_sent = now;
-      if (matcher) matcher->expect({job.event, k == 0 ? Exposure::A : Exposure::B, now});
+      }
+      {
+        std::lock_guard lock(trigger_mutex);
+        arrivals = frames_arrived;
+      }
+      sent = steady_ns();
+      if (k == 0) frame_a_sent = sent;
+      if (matcher) matcher->expect({job.event, k == 0 ? Exposure::A : Exposure::B, sent});
       trigger_taken();
       send_trigger();
     }
+    // The warm-up frame answers late (a camera not ready yet): it teaches no latency.
+    if (running && !disconnected) await_answer(sent, arrivals, std::nullopt, job.event.has_value());
   }
 }
 
@@ -285,6 +383,7 @@ void AravisCamera::Impl::deliver(const detail::StreamBuffer& buffer, FrameIdUnwr
     pool->give_back(buffer.token);
     return;
   }
+  frame_arrived();  // complete or not, stale or not: the camera answered a trigger
   const auto sequence = unwrapper.unwrap(raw_id);
   frame_id_gaps = unwrapper.gaps();
   if (sequence) frames_seen(*sequence);  // failed or not, the camera answered its trigger
@@ -412,6 +511,10 @@ void AravisCamera::start(FrameSink sink) {
     impl_->triggers_taken = impl_->triggers_answered = 0;
   }
   impl_->trigger_jobs.clear();
+  impl_->frames_arrived = 0;
+  impl_->last_arrival_ns = 0;
+  impl_->answer_latencies.clear();
+  impl_->nudges = 0;
   impl_->unmatched = 0;
   if (impl_->options.trigger_source == "Software" && impl_->options.match_tolerance_ns > 0 &&
       impl_->options.frame_mode != config::FrameMode::free_run)
