@@ -476,6 +476,8 @@ int AravisCamera::triggers_per_set() const {
   return 1;
 }
 
+std::size_t AravisCamera::payload_bytes() const { return impl_->payload; }
+
 void AravisCamera::configure(const config::CameraConfig& config) {
   std::lock_guard lock(impl_->mutex);
   if (impl_->running) throw runtime_error(fmt::format("camera {}: cannot configure while running; stop it first", impl_->id));

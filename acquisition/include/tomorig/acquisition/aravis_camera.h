@@ -105,6 +105,8 @@ class AravisCamera final : public Camera {
   // Trigger pulses the camera needs per double-frame set: 1 (hardware), 2 (two_triggers),
   // 0 (free_run).
   int triggers_per_set() const;
+  // Bytes of one frame as the configured camera reports them (0 before configure()).
+  std::size_t payload_bytes() const;
 
  private:
   struct Impl;
