@@ -521,7 +521,10 @@ void AravisCamera::start(FrameSink sink) {
   if (impl_->options.trigger_source == "Software" && impl_->options.match_tolerance_ns > 0 &&
       impl_->options.frame_mode != config::FrameMode::free_run)
     impl_->matcher = std::make_unique<TriggerMatcher>(frames_per_trigger(impl_->options.frame_mode),
-                                                      impl_->options.match_tolerance_ns);
+                                                      impl_->options.match_tolerance_ns,
+                                                      impl_->options.frame_mode == config::FrameMode::hardware
+                                                          ? impl_->options.burst_separation_ns
+                                                          : 0);
   else
     impl_->matcher.reset();
   impl_->running = true;

@@ -170,6 +170,7 @@ RigAcquisition::RigAcquisition(const config::RigConfig& rig, RigAcquisitionOptio
                                          ? std::min(separation, plan_.period_ns - separation)
                                          : plan_.period_ns;
         aravis.match_tolerance_ns = closest / 2;
+        if (cam.frame_mode == config::FrameMode::hardware) aravis.burst_separation_ns = separation;
       }
       // GenTL cameras (frame grabbers) are Aravis-engine cameras reached through a producer.
       auto camera = cam.backend == config::CameraBackend::gentl ? acquisition::make_gentl_camera(cam.id, aravis)

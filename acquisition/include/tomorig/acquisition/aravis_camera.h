@@ -47,6 +47,9 @@ struct AravisCameraOptions {
   // (TriggerMatcher) within this tolerance, below half the closest spacing of two triggers;
   // 0: frames are counted instead (frame k of the stream is set k / 2 since start).
   std::int64_t match_tolerance_ns = 0;
+  // frame_mode hardware with match_tolerance_ns: frame B's time after frame A's by the plan, so
+  // the frames' roles come from time (TriggerMatcher), not from the frame counter's parity alone.
+  std::int64_t burst_separation_ns = 0;
   int packet_size = 0;                      // GigE GevSCPSPacketSize in bytes; 0: camera's value
   int socket_buffer_bytes = 0;              // GigE receive socket buffer; 0: Aravis default
   // GigE: how long an incomplete frame waits for missing packets before it fails (Aravis
