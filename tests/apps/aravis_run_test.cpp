@@ -262,6 +262,41 @@ TEST_F(GigEFakeRig, TwoTriggersASetGiveCompleteSetsWhosePairsComeFromOneEvent) {
   EXPECT_EQ(session.read_set(0).cameras[3].camera_id, "camD");
 }
 
+// frame_mode "free_run": the fakes stream at their own 25 Hz, unsynchronised. Allowed, with a
+// warning on every status line; their frames fill the sets marked unsynchronised
+// (frame_present 2 in the file), and no set is ever called complete; the run ends normally.
+TEST_F(GigEFakeRig, FreeRunningCamerasAreWarnedAboutOnEveryLineAndNoSetIsComplete) {
+  constexpr int kSets = 10;
+  write_rig(rig_toml("free_run"));
+  const auto out = dir_ / "free.h5";
+  CliResult r = run_tomorig("run --config " + shell_quoted(rig_.string()) + " --sets " + std::to_string(kSets) +
+                            " --status none -o " + shell_quoted(out.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  int status_lines = 0;
+  std::istringstream lines(r.err);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find("recording: set ") == std::string::npos) continue;
+    ++status_lines;
+    EXPECT_NE(line.find("WARNING free-running cameras camA, camB, camC, camD"), std::string::npos) << line;
+  }
+  EXPECT_GE(status_lines, 2) << r.err;  // the closing line at least, and one during the run
+  const storage::SessionReader session(out);
+  ASSERT_EQ(session.set_count(), static_cast<std::uint64_t>(kSets));
+  EXPECT_EQ(session.incomplete_sets(), static_cast<std::uint64_t>(kSets));
+  int unsynchronised = 0;
+  for (std::uint64_t k = 0; k < session.set_count(); ++k) {
+    const storage::SetRecord rec = session.set_record(k);
+    for (int c = 0; c < kFakes; ++c)
+      for (int e = 0; e < 2; ++e) {
+        if (!rec.frame_present[c][e]) continue;
+        EXPECT_FALSE(rec.frame_synchronised[c][e]) << "set " << k << " camera " << c;
+        ++unsynchronised;
+      }
+  }
+  // The fakes stream at 25 Hz, five frames a 5 Hz set: most slots are filled.
+  EXPECT_GE(unsynchronised, kSets * kFakes * 2 / 2) << r.err;
+}
+
 TEST_F(GigEFakeRig, HardwareModeOnSingleFrameCamerasIsRefusedBeforeAnythingRuns) {
   write_rig(rig_toml("hardware"));
   const auto out = dir_ / "wrong-mode.h5";
