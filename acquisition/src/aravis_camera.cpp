@@ -33,6 +33,8 @@ constexpr std::int64_t kNudgeMarginNs = 3'000'000;
 constexpr std::int64_t kNudgeGuardNs = 20'000'000;
 constexpr std::size_t kLatenciesKept = 16;
 constexpr std::size_t kLatenciesNeeded = 4;
+// Answers seen before the trigger phase is judged against the readout (two_triggers).
+constexpr std::size_t kLatenciesForPhase = 8;
 // GigE Vision bootstrap register CCP (control channel privilege): reading it changes nothing,
 // and every GigE Vision camera answers it (Aravis's heartbeat reads it too).
 constexpr guint32 kGvControlChannelPrivilege = 0x0A00;
@@ -94,6 +96,9 @@ struct AravisCamera::Impl {
   std::uint64_t frames_arrived = 0;
   std::int64_t last_arrival_ns = 0;
   std::deque<std::int64_t> answer_latencies;  // trigger thread only: trigger sent -> frame arrived
+  // Trigger thread only: how much later than asked each job's triggers go out (readout_ns).
+  std::int64_t phase_delay_ns = 0;
+  bool phase_judged = false;
   std::atomic<std::uint64_t> nudges{0};
   // Software triggers: which trigger each frame answers, by time (null: frames are counted).
   std::unique_ptr<TriggerMatcher> matcher;
@@ -121,6 +126,8 @@ struct AravisCamera::Impl {
   void await_answer(std::int64_t sent_ns, std::uint64_t arrivals_before, std::optional<std::int64_t> deadline_ns,
                     bool learn);
   void nudge();
+  std::optional<std::int64_t> median_answer_latency() const;
+  void judge_trigger_phase();
   bool send_trigger();  // false: the command failed and the camera is marked disconnected
   void trigger_taken();
   void frames_seen(std::uint64_t sequence);
@@ -211,14 +218,32 @@ void AravisCamera::Impl::nudge() {
 // merges with this one (one frame for two triggers: a frame lost), or nothing for 100 ms (a
 // frame far off its trigger). Any GVCP command wakes it; the read makes the frame ~3 ms late
 // instead of lost. For a camera that answered, nothing is sent.
+std::optional<std::int64_t> AravisCamera::Impl::median_answer_latency() const {
+  if (answer_latencies.size() < kLatenciesNeeded) return std::nullopt;
+  std::vector<std::int64_t> sorted(answer_latencies.begin(), answer_latencies.end());
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+  return sorted[sorted.size() / 2];
+}
+
+// Once per run (see AravisCameraOptions::readout_ns): a two-trigger camera that answers sooner
+// than a quarter of its readout gets its triggers just past its grid line instead of just
+// before it. A camera without a grid answers at the same latency either way; it only
+// triggers that much later, once.
+void AravisCamera::Impl::judge_trigger_phase() {
+  if (phase_judged || options.frame_mode != config::FrameMode::two_triggers || options.readout_ns <= 0 ||
+      answer_latencies.size() < kLatenciesForPhase)
+    return;
+  phase_judged = true;
+  const std::int64_t latency = *median_answer_latency();
+  if (latency >= options.readout_ns / 4) return;
+  phase_delay_ns = latency + options.readout_ns / 8;
+  answer_latencies.clear();  // a new regime: the nudge learns it again
+}
+
 void AravisCamera::Impl::await_answer(std::int64_t sent_ns, std::uint64_t arrivals_before,
                                       std::optional<std::int64_t> deadline_ns, bool learn) {
   std::optional<std::int64_t> nudge_at;
-  if (answer_latencies.size() >= kLatenciesNeeded) {
-    std::vector<std::int64_t> sorted(answer_latencies.begin(), answer_latencies.end());
-    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
-    nudge_at = sent_ns + sorted[sorted.size() / 2] + kNudgeMarginNs;
-  }
+  if (const auto latency = median_answer_latency()) nudge_at = sent_ns + *latency + kNudgeMarginNs;
   const std::int64_t cap = deadline_ns ? *deadline_ns : sent_ns + std::chrono::nanoseconds(options.frame_timeout).count();
   bool nudged = false;
   std::unique_lock lock(trigger_mutex);
@@ -261,6 +286,12 @@ void AravisCamera::Impl::trigger_loop() {
       trigger_jobs.pop_front();
     }
     const int triggers = job.event && options.frame_mode == config::FrameMode::two_triggers ? 2 : 1;
+    judge_trigger_phase();
+    if (job.event && phase_delay_ns > 0) {
+      std::unique_lock lock(trigger_mutex);
+      trigger_wanted.wait_for(lock, std::chrono::nanoseconds(phase_delay_ns), [&] { return !running; });
+      if (!running) return;
+    }
     std::int64_t frame_a_sent = 0;
     std::int64_t sent = 0;
     std::uint64_t arrivals = 0;
@@ -516,6 +547,8 @@ void AravisCamera::start(FrameSink sink) {
   impl_->frames_arrived = 0;
   impl_->last_arrival_ns = 0;
   impl_->answer_latencies.clear();
+  impl_->phase_delay_ns = 0;
+  impl_->phase_judged = false;
   impl_->nudges = 0;
   impl_->unmatched = 0;
   if (impl_->options.trigger_source == "Software" && impl_->options.match_tolerance_ns > 0 &&

@@ -171,6 +171,7 @@ RigAcquisition::RigAcquisition(const config::RigConfig& rig, RigAcquisitionOptio
                                          : plan_.period_ns;
         aravis.match_tolerance_ns = closest / 2;
         if (cam.frame_mode == config::FrameMode::hardware) aravis.burst_separation_ns = separation;
+        if (cam.frame_mode == config::FrameMode::two_triggers) aravis.readout_ns = plan_.camera.readout_ns;
       }
       // GenTL cameras (frame grabbers) are Aravis-engine cameras reached through a producer.
       auto camera = cam.backend == config::CameraBackend::gentl ? acquisition::make_gentl_camera(cam.id, aravis)

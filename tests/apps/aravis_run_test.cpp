@@ -238,11 +238,11 @@ TEST_F(GigEFakeRig, TwoTriggersASetGiveCompleteSetsWhosePairsComeFromOneEvent) {
   EXPECT_TRUE(session.recording_complete());
   // The fake looks for a trigger only on a 40 ms grid of the wall clock, so its B - A is 80 ms
   // or, when the host's scheduling delays a trigger across a grid line, 40 or 120 ms: that pair
-  // is dropped (its set flagged), never kept across events. On a quiet machine that is rare
-  // (the 200-set run of docs/acquisition.md); on a 2-core machine shared with compilers it
-  // happens in bursts, so here the check is that most sets are complete and every pair kept
-  // is right (below).
-  EXPECT_LE(session.incomplete_sets(), kSets / 3) << r.err;
+  // is dropped (its set flagged), never kept across events. Once each camera has learned its
+  // answer latency (4 events), its triggers go out just past the grid line, with 35 ms to spare
+  // (AravisCameraOptions::readout_ns): on a 2-core machine running four compilers (load 16)
+  // 40- and 60-set runs then flagged 0-2 sets, where a third were flagged before.
+  EXPECT_LE(session.incomplete_sets(), kSets / 5) << r.err;
   // Every trigger is answered by a frame: a trigger the fake merged with the next one or lost
   // (it sleeps through a grid line now and then; the camera nudges it) is a frame that never
   // comes, unlike a grid crossing, whose frames come and are dropped by the pair check. On a
@@ -360,13 +360,12 @@ TEST_F(GigEFakeRig, AKilledCameraIsNamedAndContinueFinishesTheRunWithItsFramesMi
   // answer every trigger: each delivers its 50 frames, 2 at most short of that (each camera
   // has its own trigger thread, so the dead camera's unanswered commands hold up no other
   // camera; a host too busy for the fakes may merge a trigger, see the first test). Their
-  // pairs in the file may miss more: the pair check drops the pairs a busy host pushed across
-  // the fake's 40 ms grid, before the kill as much as after it (on a 2-core machine running
-  // four compilers, a third of them; on a quiet one next to none, unless the run starts with its
-  // triggers just before the fakes' grid lines: docs/acquisition.md), so that bound stays loose.
+  // pairs in the file may miss a few more: the pair check drops the pairs a busy host pushed
+  // across the fake's 40 ms grid, before the kill as much as after it (the first test), at
+  // most one frame in five.
   EXPECT_GE(flagged, kSets - kKillAfter - 2);
   for (int c : {0, 1, 3}) EXPECT_GE(frames_delivered(run.err(), kCameraIds[c]), 2 * kSets - 2) << run.err();
-  EXPECT_LE(others_missing, kSets * 2 * 3 / 3) << run.err();
+  EXPECT_LE(others_missing, kSets * 2 * 3 / 5) << run.err();
   for (int c : {0, 1, 3}) expect_pairs_from_their_own_events(session, c);
 }
 

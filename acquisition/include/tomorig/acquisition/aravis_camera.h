@@ -50,6 +50,14 @@ struct AravisCameraOptions {
   // frame_mode hardware with match_tolerance_ns: frame B's time after frame A's by the plan, so
   // the frames' roles come from time (TriggerMatcher), not from the frame counter's parity alone.
   std::int64_t burst_separation_ns = 0;
+  // frame_mode two_triggers with software triggers: the camera's readout time (the plan's
+  // readout_us; 0: unknown). A camera that takes a trigger only at the end of its readout (a
+  // frame grid, like Aravis's GigE fake) answers it at the next grid line: a trigger sent just
+  // before one moves a whole readout later with the smallest host delay, and its pair is lost.
+  // Once the camera's answer latency is learned and is under a quarter of the readout, the
+  // camera's triggers are sent that latency plus an eighth of the readout later, just after
+  // the grid line: a delay then has most of a readout to spare.
+  std::int64_t readout_ns = 0;
   int packet_size = 0;                      // GigE GevSCPSPacketSize in bytes; 0: camera's value
   int socket_buffer_bytes = 0;              // GigE receive socket buffer; 0: Aravis default
   // GigE: how long an incomplete frame waits for missing packets before it fails (Aravis
