@@ -1,10 +1,15 @@
 #include "tomorig/acquisition/aravis_camera.h"
 
+#include <arpa/inet.h>
 #include <arv.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <cstring>
 #include <atomic>
 #include <condition_variable>
 #include <deque>
@@ -29,8 +34,8 @@ constexpr std::chrono::microseconds kPopTimeout{50'000};
 // A trigger whose frame is this much later than the camera's usual answer gets one nudge (a
 // register read, see await_answer()); the answer latency is the median of the last few.
 constexpr std::int64_t kNudgeMarginNs = 3'000'000;
-// Only with this much time left before the camera's next trigger: the read waits for its ack.
-constexpr std::int64_t kNudgeGuardNs = 20'000'000;
+// Not within this much of the camera's next trigger: the nudge would come too late to matter.
+constexpr std::int64_t kNudgeGuardNs = 5'000'000;
 constexpr std::size_t kLatenciesKept = 16;
 constexpr std::size_t kLatenciesNeeded = 4;
 // Answers seen before the trigger phase is judged against the readout (two_triggers).
@@ -100,6 +105,13 @@ struct AravisCamera::Impl {
   std::int64_t phase_delay_ns = 0;
   bool phase_judged = false;
   std::atomic<std::uint64_t> nudges{0};
+  // GigE Vision: a socket of our own for the nudge's GVCP packet, sent without waiting for an
+  // answer, so a nudge never holds up the camera's next trigger (-1: no nudges).
+  int nudge_socket = -1;
+  sockaddr_in nudge_to{};
+  std::uint16_t nudge_request = 0;
+  void open_nudge_socket();
+  void close_nudge_socket();
   // Software triggers: which trigger each frame answers, by time (null: frames are counted).
   std::unique_ptr<TriggerMatcher> matcher;
   std::atomic<std::uint64_t> unmatched{0};
@@ -154,8 +166,13 @@ void AravisCamera::Impl::trigger_taken() {
 void AravisCamera::Impl::frames_seen(std::uint64_t sequence) {
   const std::uint64_t per_trigger = static_cast<std::uint64_t>(frames_per_trigger(options.frame_mode));
   const std::uint64_t answered = sequence / per_trigger + 1;
+  // A camera that merged two triggers into one frame (Aravis's GigE fake does, see
+  // await_answer()) leaves the count one trigger behind for good; a few such and the oldest
+  // "unanswered" trigger would be older than the frame timeout although frames keep coming.
+  // A frame arriving says the camera is alive: triggers sent long before it are answered.
+  const std::int64_t stale = steady_ns() - std::chrono::nanoseconds(options.frame_timeout).count() / 2;
   std::lock_guard lock(watch_mutex);
-  while (triggers_answered < answered && !unanswered_triggers.empty()) {
+  while (!unanswered_triggers.empty() && (triggers_answered < answered || unanswered_triggers.front() < stale)) {
     unanswered_triggers.pop_front();
     ++triggers_answered;
   }
@@ -196,14 +213,40 @@ void AravisCamera::Impl::frame_arrived() {
   trigger_wanted.notify_all();
 }
 
-// A GVCP register read: any command makes a camera that polls its control socket look at its
-// state again (see await_answer()); it triggers nothing. Errors are left to the connection
-// watch (a dead camera fails its next trigger or misses the frame timeout).
+void AravisCamera::Impl::open_nudge_socket() {
+  close_nudge_socket();
+  if (!camera || !arv_camera_is_gv_device(camera.get())) return;
+  GSocketAddress* address = arv_gv_device_get_device_address(ARV_GV_DEVICE(arv_camera_get_device(camera.get())));
+  if (address == nullptr || !G_IS_INET_SOCKET_ADDRESS(address)) return;
+  gchar* text = g_inet_address_to_string(g_inet_socket_address_get_address(G_INET_SOCKET_ADDRESS(address)));
+  nudge_to = sockaddr_in{};
+  nudge_to.sin_family = AF_INET;
+  nudge_to.sin_port = htons(3956);  // GVCP
+  const bool parsed = text != nullptr && inet_pton(AF_INET, text, &nudge_to.sin_addr) == 1;
+  g_free(text);
+  if (parsed) nudge_socket = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+}
+
+void AravisCamera::Impl::close_nudge_socket() {
+  if (nudge_socket >= 0) ::close(nudge_socket);
+  nudge_socket = -1;
+}
+
+// A GVCP READREG of the CCP register from a socket of our own, no acknowledgement asked for
+// and none waited for: any command makes a camera that polls its control socket look at its
+// state again (see await_answer()); it triggers nothing and changes nothing (reads are open to
+// any host). Answers that come anyway (the fake answers every command) are drained and dropped.
 void AravisCamera::Impl::nudge() {
-  if (!arv_camera_is_gv_device(camera.get())) return;
-  GErrorSlot error;
-  guint32 value = 0;
-  arv_device_read_register(arv_camera_get_device(camera.get()), kGvControlChannelPrivilege, &value, error.out());
+  if (nudge_socket < 0) return;
+  if (++nudge_request == 0) nudge_request = 1;  // GVCP request ids are never 0
+  const std::uint32_t address = htonl(kGvControlChannelPrivilege);
+  unsigned char packet[12] = {0x42, 0x00, 0x00, 0x80, 0x00, 0x04,  // key, flags (no ack), READREG_CMD, length 4
+                              static_cast<unsigned char>(nudge_request >> 8), static_cast<unsigned char>(nudge_request & 0xff)};
+  std::memcpy(packet + 8, &address, sizeof address);
+  ::sendto(nudge_socket, packet, sizeof packet, 0, reinterpret_cast<const sockaddr*>(&nudge_to), sizeof nudge_to);
+  unsigned char drain[64];
+  while (::recv(nudge_socket, drain, sizeof drain, 0) > 0) {
+  }
   ++nudges;
 }
 
@@ -226,8 +269,7 @@ std::optional<std::int64_t> AravisCamera::Impl::median_answer_latency() const {
 }
 
 // Once per run (see AravisCameraOptions::readout_ns): a two-trigger camera that answers sooner
-// than a quarter of its readout gets its triggers just past its grid line instead of just
-// before it. A camera without a grid answers at the same latency either way; it only
+// than half its readout gets its triggers just past its grid line instead of before it. A camera without a grid answers at the same latency either way; it only
 // triggers that much later, once.
 void AravisCamera::Impl::judge_trigger_phase() {
   if (phase_judged || options.frame_mode != config::FrameMode::two_triggers || options.readout_ns <= 0 ||
@@ -235,9 +277,13 @@ void AravisCamera::Impl::judge_trigger_phase() {
     return;
   phase_judged = true;
   const std::int64_t latency = *median_answer_latency();
-  if (latency >= options.readout_ns / 4) return;
+  if (latency >= options.readout_ns / 2) return;
   phase_delay_ns = latency + options.readout_ns / 8;
-  answer_latencies.clear();  // a new regime: the nudge learns it again
+  // A new regime: the nudge learns the latency again, and the matcher the camera's offset (on
+  // a grid camera it grows by most of a readout; a stale offset would let a frame that crossed
+  // a grid line pass for the next trigger's).
+  answer_latencies.clear();
+  if (matcher) matcher->relearn_offsets();
 }
 
 void AravisCamera::Impl::await_answer(std::int64_t sent_ns, std::uint64_t arrivals_before,
@@ -493,6 +539,7 @@ AravisCamera::AravisCamera(std::string id, AravisCameraOptions options, std::uni
 
 AravisCamera::~AravisCamera() {
   stop();
+  impl_->close_nudge_socket();
   impl_->forget_camera();
 }
 
@@ -560,6 +607,7 @@ void AravisCamera::start(FrameSink sink) {
                                                           : 0);
   else
     impl_->matcher.reset();
+  impl_->open_nudge_socket();
   impl_->running = true;
   impl_->delivery = std::thread([impl = impl_.get()] { impl->deliver_loop(); });
   impl_->trigger_thread = std::thread([impl = impl_.get()] { impl->trigger_loop(); });
@@ -569,6 +617,7 @@ void AravisCamera::start(FrameSink sink) {
     impl_->trigger_wanted.notify_all();
     impl_->delivery.join();
     impl_->trigger_thread.join();
+    impl_->close_nudge_socket();
     throw runtime_error(fmt::format("camera {}: AcquisitionStart failed: {}", impl_->id, error.message()));
   }
 }
@@ -590,6 +639,7 @@ void AravisCamera::stop() {
     std::lock_guard pool_lock(impl_->pool_mutex);
     if (impl_->pool) impl_->pool->stop();
   }
+  impl_->close_nudge_socket();
   impl_->sink = nullptr;
 }
 

@@ -121,6 +121,13 @@ std::optional<TriggerMatcher::Match> TriggerMatcher::match(std::uint64_t frame_i
   return Match{hit.event, hit.exposure};
 }
 
+void TriggerMatcher::relearn_offsets() {
+  std::lock_guard lock(mutex_);
+  offsets_[0].clear();
+  offsets_[1].clear();
+  misses_in_a_row_ = 0;
+}
+
 std::uint64_t TriggerMatcher::triggers_lost() const {
   std::lock_guard lock(mutex_);
   return lost_;

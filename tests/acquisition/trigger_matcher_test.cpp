@@ -149,6 +149,24 @@ TEST(TriggerMatcher, AFirstFrameLostEntirelyDoesNotSwapTheRolesOfTheRun) {
   EXPECT_EQ(m.triggers_lost(), 0u);
 }
 
+// The camera's triggers move to another phase of its readout grid (two_triggers, see
+// AravisCameraOptions::readout_ns): its offset grows by 35 ms. Relearnt, the next frames
+// answer their own triggers; with the stale offset, a frame that also crossed a grid line
+// (+40 ms) would pass for the next trigger's.
+TEST(TriggerMatcher, RelearntOffsetsFollowAShiftedPhase) {
+  TriggerMatcher m(1, 40 * kMs);
+  expect_events(m, 3);  // A at 200k, B at 200k + 60 ms
+  EXPECT_EQ(m.match(0, kCameraClock + 2 * kMs)->event, 0u);
+  EXPECT_EQ(m.match(1, kCameraClock + 62 * kMs)->exposure, Exposure::B);
+  m.relearn_offsets();
+  // Event 1's frame A 35 ms later than before plus a 40 ms grid crossing: 77 ms after its
+  // trigger, 17 ms after frame B's trigger plus the old offset.
+  const auto a1 = m.match(2, kCameraClock + 200 * kMs + 77 * kMs);
+  ASSERT_TRUE(a1);
+  EXPECT_EQ(a1->event, 1u);
+  EXPECT_EQ(a1->exposure, Exposure::A);
+}
+
 TEST(TriggerMatcher, OptionsAreChecked) {
   EXPECT_THROW(TriggerMatcher(3, kMs), Error);
   EXPECT_THROW(TriggerMatcher(1, 0), Error);

@@ -54,7 +54,7 @@ struct AravisCameraOptions {
   // readout_us; 0: unknown). A camera that takes a trigger only at the end of its readout (a
   // frame grid, like Aravis's GigE fake) answers it at the next grid line: a trigger sent just
   // before one moves a whole readout later with the smallest host delay, and its pair is lost.
-  // Once the camera's answer latency is learned and is under a quarter of the readout, the
+  // Once the camera's answer latency is learned and is under half the readout, the
   // camera's triggers are sent that latency plus an eighth of the readout later, just after
   // the grid line: a delay then has most of a readout to spare.
   std::int64_t readout_ns = 0;

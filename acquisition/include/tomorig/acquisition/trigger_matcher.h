@@ -56,6 +56,11 @@ class TriggerMatcher {
   std::optional<Match> match(std::uint64_t frame_id, std::int64_t timestamp_ns,
                              std::optional<Exposure> burst_position = std::nullopt);
 
+  // Forgets the learned clock offsets: the camera's answer latency is about to change (its
+  // triggers move to another phase of its readout). The next frame answers the oldest pending
+  // trigger, as at the start. Thread-safe.
+  void relearn_offsets();
+
   std::uint64_t triggers_lost() const;   // passed over: their frames never came
   std::uint64_t frames_unmatched() const;
 
