@@ -1,10 +1,15 @@
 #include "tomorig/acquisition/aravis_camera.h"
 
+#include <arpa/inet.h>
 #include <arv.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <cstring>
 #include <atomic>
 #include <condition_variable>
 #include <deque>
@@ -26,6 +31,18 @@ using detail::GObjectPtr;
 
 // How often the delivery thread checks for stop() and lost frames.
 constexpr std::chrono::microseconds kPopTimeout{50'000};
+// A trigger whose frame is this much later than the camera's usual answer gets one nudge (a
+// register read, see await_answer()); the answer latency is the median of the last few.
+constexpr std::int64_t kNudgeMarginNs = 3'000'000;
+// Not within this much of the camera's next trigger: the nudge would come too late to matter.
+constexpr std::int64_t kNudgeGuardNs = 5'000'000;
+constexpr std::size_t kLatenciesKept = 16;
+constexpr std::size_t kLatenciesNeeded = 4;
+// Answers seen before the trigger phase is judged against the readout (two_triggers).
+constexpr std::size_t kLatenciesForPhase = 8;
+// GigE Vision bootstrap register CCP (control channel privilege): reading it changes nothing,
+// and every GigE Vision camera answers it (Aravis's heartbeat reads it too).
+constexpr guint32 kGvControlChannelPrivilege = 0x0A00;
 
 }  // namespace
 
@@ -76,9 +93,25 @@ struct AravisCamera::Impl {
     std::int64_t spacing_ns = 0;         // two_triggers: frame B's trigger after frame A's
   };
   std::mutex trigger_mutex;
-  std::condition_variable trigger_wanted;
+  std::condition_variable trigger_wanted;  // a job queued, a frame arrived, or stop
   std::deque<TriggerJob> trigger_jobs;
   std::thread trigger_thread;
+  // Frames that arrived (any status), when the last one did: the trigger thread's view of
+  // whether its last trigger was answered. Guarded by trigger_mutex.
+  std::uint64_t frames_arrived = 0;
+  std::int64_t last_arrival_ns = 0;
+  std::deque<std::int64_t> answer_latencies;  // trigger thread only: trigger sent -> frame arrived
+  // Trigger thread only: how much later than asked each job's triggers go out (readout_ns).
+  std::int64_t phase_delay_ns = 0;
+  bool phase_judged = false;
+  std::atomic<std::uint64_t> nudges{0};
+  // GigE Vision: a socket of our own for the nudge's GVCP packet, sent without waiting for an
+  // answer, so a nudge never holds up the camera's next trigger (-1: no nudges).
+  int nudge_socket = -1;
+  sockaddr_in nudge_to{};
+  std::uint16_t nudge_request = 0;
+  void open_nudge_socket();
+  void close_nudge_socket();
   // Software triggers: which trigger each frame answers, by time (null: frames are counted).
   std::unique_ptr<TriggerMatcher> matcher;
   std::atomic<std::uint64_t> unmatched{0};
@@ -101,6 +134,12 @@ struct AravisCamera::Impl {
   void deliver_loop();
   void deliver(const detail::StreamBuffer& buffer, FrameIdUnwrapper& unwrapper);
   void trigger_loop();
+  void frame_arrived();
+  void await_answer(std::int64_t sent_ns, std::uint64_t arrivals_before, std::optional<std::int64_t> deadline_ns,
+                    bool learn);
+  void nudge();
+  std::optional<std::int64_t> median_answer_latency() const;
+  void judge_trigger_phase();
   bool send_trigger();  // false: the command failed and the camera is marked disconnected
   void trigger_taken();
   void frames_seen(std::uint64_t sequence);
@@ -127,8 +166,13 @@ void AravisCamera::Impl::trigger_taken() {
 void AravisCamera::Impl::frames_seen(std::uint64_t sequence) {
   const std::uint64_t per_trigger = static_cast<std::uint64_t>(frames_per_trigger(options.frame_mode));
   const std::uint64_t answered = sequence / per_trigger + 1;
+  // A camera that merged two triggers into one frame (Aravis's GigE fake does, see
+  // await_answer()) leaves the count one trigger behind for good; a few such and the oldest
+  // "unanswered" trigger would be older than the frame timeout although frames keep coming.
+  // A frame arriving says the camera is alive: triggers sent long before it are answered.
+  const std::int64_t stale = steady_ns() - std::chrono::nanoseconds(options.frame_timeout).count() / 2;
   std::lock_guard lock(watch_mutex);
-  while (triggers_answered < answered && !unanswered_triggers.empty()) {
+  while (!unanswered_triggers.empty() && (triggers_answered < answered || unanswered_triggers.front() < stale)) {
     unanswered_triggers.pop_front();
     ++triggers_answered;
   }
@@ -160,8 +204,123 @@ bool AravisCamera::Impl::send_trigger() {
   return true;
 }
 
+void AravisCamera::Impl::frame_arrived() {
+  {
+    std::lock_guard lock(trigger_mutex);
+    ++frames_arrived;
+    last_arrival_ns = steady_ns();
+  }
+  trigger_wanted.notify_all();
+}
+
+void AravisCamera::Impl::open_nudge_socket() {
+  close_nudge_socket();
+  if (!camera || !arv_camera_is_gv_device(camera.get())) return;
+  GSocketAddress* address = arv_gv_device_get_device_address(ARV_GV_DEVICE(arv_camera_get_device(camera.get())));
+  if (address == nullptr || !G_IS_INET_SOCKET_ADDRESS(address)) return;
+  gchar* text = g_inet_address_to_string(g_inet_socket_address_get_address(G_INET_SOCKET_ADDRESS(address)));
+  nudge_to = sockaddr_in{};
+  nudge_to.sin_family = AF_INET;
+  nudge_to.sin_port = htons(3956);  // GVCP
+  const bool parsed = text != nullptr && inet_pton(AF_INET, text, &nudge_to.sin_addr) == 1;
+  g_free(text);
+  if (parsed) nudge_socket = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+}
+
+void AravisCamera::Impl::close_nudge_socket() {
+  if (nudge_socket >= 0) ::close(nudge_socket);
+  nudge_socket = -1;
+}
+
+// A GVCP READREG of the CCP register from a socket of our own, no acknowledgement asked for
+// and none waited for: any command makes a camera that polls its control socket look at its
+// state again (see await_answer()); it triggers nothing and changes nothing (reads are open to
+// any host). Answers that come anyway (the fake answers every command) are drained and dropped.
+void AravisCamera::Impl::nudge() {
+  if (nudge_socket < 0) return;
+  if (++nudge_request == 0) nudge_request = 1;  // GVCP request ids are never 0
+  const std::uint32_t address = htonl(kGvControlChannelPrivilege);
+  unsigned char packet[12] = {0x42, 0x00, 0x00, 0x80, 0x00, 0x04,  // key, flags (no ack), READREG_CMD, length 4
+                              static_cast<unsigned char>(nudge_request >> 8), static_cast<unsigned char>(nudge_request & 0xff)};
+  std::memcpy(packet + 8, &address, sizeof address);
+  ::sendto(nudge_socket, packet, sizeof packet, 0, reinterpret_cast<const sockaddr*>(&nudge_to), sizeof nudge_to);
+  unsigned char drain[64];
+  while (::recv(nudge_socket, drain, sizeof drain, 0) > 0) {
+  }
+  ++nudges;
+}
+
+// Waits for the frame of the trigger sent at `sent_ns` (the first frame to arrive after it)
+// until `deadline_ns` (the next trigger of this job), else until the next job is queued or the
+// frame timeout. A camera answers its triggers with a steady latency (a fixed phase of its
+// readout); one whose frame is kNudgeMarginNs later than the median of its last answers gets
+// one register read. Aravis's GigE fake needs it: it looks for a latched software trigger
+// only on its 40 ms grid, and now and then sleeps through a grid line (its poll timeout is
+// computed unsigned, and a clock tick between two reads of the time turns it into 100 ms), so
+// the latched trigger waits for the next packet to arrive: the next trigger, which it then
+// merges with this one (one frame for two triggers: a frame lost), or nothing for 100 ms (a
+// frame far off its trigger). Any GVCP command wakes it; the read makes the frame ~3 ms late
+// instead of lost. For a camera that answered, nothing is sent.
+std::optional<std::int64_t> AravisCamera::Impl::median_answer_latency() const {
+  if (answer_latencies.size() < kLatenciesNeeded) return std::nullopt;
+  std::vector<std::int64_t> sorted(answer_latencies.begin(), answer_latencies.end());
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+  return sorted[sorted.size() / 2];
+}
+
+// Once per run (see AravisCameraOptions::readout_ns): a two-trigger camera that answers sooner
+// than half its readout gets its triggers just past its grid line instead of before it. A camera without a grid answers at the same latency either way; it only
+// triggers that much later, once.
+void AravisCamera::Impl::judge_trigger_phase() {
+  if (phase_judged || options.frame_mode != config::FrameMode::two_triggers || options.readout_ns <= 0 ||
+      answer_latencies.size() < kLatenciesForPhase)
+    return;
+  phase_judged = true;
+  const std::int64_t latency = *median_answer_latency();
+  if (latency >= options.readout_ns / 2) return;
+  phase_delay_ns = latency + options.readout_ns / 8;
+  // A new regime: the nudge learns the latency again, and the matcher the camera's offset (on
+  // a grid camera it grows by most of a readout; a stale offset would let a frame that crossed
+  // a grid line pass for the next trigger's).
+  answer_latencies.clear();
+  if (matcher) matcher->relearn_offsets();
+}
+
+void AravisCamera::Impl::await_answer(std::int64_t sent_ns, std::uint64_t arrivals_before,
+                                      std::optional<std::int64_t> deadline_ns, bool learn) {
+  std::optional<std::int64_t> nudge_at;
+  if (const auto latency = median_answer_latency()) nudge_at = sent_ns + *latency + kNudgeMarginNs;
+  const std::int64_t cap = deadline_ns ? *deadline_ns : sent_ns + std::chrono::nanoseconds(options.frame_timeout).count();
+  bool nudged = false;
+  std::unique_lock lock(trigger_mutex);
+  auto answered = [&] { return frames_arrived > arrivals_before; };
+  auto next_job_waits = [&] { return !deadline_ns && !trigger_jobs.empty(); };
+  while (running && !disconnected && !answered() && !next_job_waits()) {
+    const std::int64_t now = steady_ns();
+    if (now >= cap) break;
+    if (nudge_at && !nudged && now >= *nudge_at) {
+      nudged = true;
+      if (cap - now > kNudgeGuardNs) {
+        lock.unlock();
+        nudge();
+        lock.lock();
+      }
+      continue;
+    }
+    const std::int64_t wake = nudge_at && !nudged ? std::min(cap, *nudge_at) : cap;
+    trigger_wanted.wait_until(lock, std::chrono::steady_clock::time_point(std::chrono::nanoseconds(wake)),
+                              [&] { return !running || answered() || next_job_waits(); });
+  }
+  // Latencies of nudged answers would teach the nudge's own delay.
+  if (learn && !nudged && answered() && last_arrival_ns >= sent_ns) {
+    answer_latencies.push_back(last_arrival_ns - sent_ns);
+    if (answer_latencies.size() > kLatenciesKept) answer_latencies.pop_front();
+  }
+}
+
 // One job per trigger event: frame A's trigger, and for two_triggers frame B's, spaced from
 // when A's was really sent (not when it was asked for), so a busy host delays both alike.
+// Between triggers the thread watches for each trigger's frame (await_answer()).
 void AravisCamera::Impl::trigger_loop() {
   for (;;) {
     TriggerJob job;
@@ -173,16 +332,32 @@ void AravisCamera::Impl::trigger_loop() {
       trigger_jobs.pop_front();
     }
     const int triggers = job.event && options.frame_mode == config::FrameMode::two_triggers ? 2 : 1;
+    judge_trigger_phase();
+    if (job.event && phase_delay_ns > 0) {
+      std::unique_lock lock(trigger_mutex);
+      trigger_wanted.wait_for(lock, std::chrono::nanoseconds(phase_delay_ns), [&] { return !running; });
+      if (!running) return;
+    }
     std::int64_t frame_a_sent = 0;
+    std::int64_t sent = 0;
+    std::uint64_t arrivals = 0;
     for (int k = 0; k < triggers && !disconnected && running; ++k) {
-      if (k == 1)
+      if (k == 1) {
+        await_answer(sent, arrivals, frame_a_sent + job.spacing_ns, true);
         std::this_thread::sleep_until(std::chrono::steady_clock::time_point(std::chrono::nanoseconds(frame_a_sent + job.spacing_ns)));
-      const std::int64_t now = steady_ns();
-      if (k == 0) frame_a_sent = now;
-      if (matcher) matcher->expect({job.event, k == 0 ? Exposure::A : Exposure::B, now});
+      }
+      {
+        std::lock_guard lock(trigger_mutex);
+        arrivals = frames_arrived;
+      }
+      sent = steady_ns();
+      if (k == 0) frame_a_sent = sent;
+      if (matcher) matcher->expect({job.event, k == 0 ? Exposure::A : Exposure::B, sent});
       trigger_taken();
       send_trigger();
     }
+    // The warm-up frame answers late (a camera not ready yet): it teaches no latency.
+    if (running && !disconnected) await_answer(sent, arrivals, std::nullopt, job.event.has_value());
   }
 }
 
@@ -285,6 +460,7 @@ void AravisCamera::Impl::deliver(const detail::StreamBuffer& buffer, FrameIdUnwr
     pool->give_back(buffer.token);
     return;
   }
+  frame_arrived();  // complete or not, stale or not: the camera answered a trigger
   const auto sequence = unwrapper.unwrap(raw_id);
   frame_id_gaps = unwrapper.gaps();
   if (sequence) frames_seen(*sequence);  // failed or not, the camera answered its trigger
@@ -363,6 +539,7 @@ AravisCamera::AravisCamera(std::string id, AravisCameraOptions options, std::uni
 
 AravisCamera::~AravisCamera() {
   stop();
+  impl_->close_nudge_socket();
   impl_->forget_camera();
 }
 
@@ -376,6 +553,8 @@ int AravisCamera::triggers_per_set() const {
   }
   return 1;
 }
+
+std::size_t AravisCamera::payload_bytes() const { return impl_->payload; }
 
 void AravisCamera::configure(const config::CameraConfig& config) {
   std::lock_guard lock(impl_->mutex);
@@ -412,13 +591,23 @@ void AravisCamera::start(FrameSink sink) {
     impl_->triggers_taken = impl_->triggers_answered = 0;
   }
   impl_->trigger_jobs.clear();
+  impl_->frames_arrived = 0;
+  impl_->last_arrival_ns = 0;
+  impl_->answer_latencies.clear();
+  impl_->phase_delay_ns = 0;
+  impl_->phase_judged = false;
+  impl_->nudges = 0;
   impl_->unmatched = 0;
   if (impl_->options.trigger_source == "Software" && impl_->options.match_tolerance_ns > 0 &&
       impl_->options.frame_mode != config::FrameMode::free_run)
     impl_->matcher = std::make_unique<TriggerMatcher>(frames_per_trigger(impl_->options.frame_mode),
-                                                      impl_->options.match_tolerance_ns);
+                                                      impl_->options.match_tolerance_ns,
+                                                      impl_->options.frame_mode == config::FrameMode::hardware
+                                                          ? impl_->options.burst_separation_ns
+                                                          : 0);
   else
     impl_->matcher.reset();
+  impl_->open_nudge_socket();
   impl_->running = true;
   impl_->delivery = std::thread([impl = impl_.get()] { impl->deliver_loop(); });
   impl_->trigger_thread = std::thread([impl = impl_.get()] { impl->trigger_loop(); });
@@ -428,6 +617,7 @@ void AravisCamera::start(FrameSink sink) {
     impl_->trigger_wanted.notify_all();
     impl_->delivery.join();
     impl_->trigger_thread.join();
+    impl_->close_nudge_socket();
     throw runtime_error(fmt::format("camera {}: AcquisitionStart failed: {}", impl_->id, error.message()));
   }
 }
@@ -449,6 +639,7 @@ void AravisCamera::stop() {
     std::lock_guard pool_lock(impl_->pool_mutex);
     if (impl_->pool) impl_->pool->stop();
   }
+  impl_->close_nudge_socket();
   impl_->sink = nullptr;
 }
 

@@ -16,8 +16,10 @@ constexpr int kMissesBeforeRelearning = 3;
 
 }  // namespace
 
-TriggerMatcher::TriggerMatcher(int frames_per_trigger, std::int64_t tolerance_ns)
-    : frames_per_trigger_(frames_per_trigger), tolerance_ns_(tolerance_ns) {
+TriggerMatcher::TriggerMatcher(int frames_per_trigger, std::int64_t tolerance_ns, std::int64_t burst_separation_ns)
+    : frames_per_trigger_(frames_per_trigger), tolerance_ns_(tolerance_ns), burst_separation_ns_(burst_separation_ns) {
+  if (burst_separation_ns < 0)
+    throw bad_input(fmt::format("trigger matcher: burst separation {} ns must be >= 0", burst_separation_ns));
   if (frames_per_trigger != 1 && frames_per_trigger != 2)
     throw bad_input(fmt::format("trigger matcher: {} frames per trigger; a camera makes 1 or 2", frames_per_trigger));
   if (tolerance_ns <= 0) throw bad_input(fmt::format("trigger matcher: tolerance {} ns must be > 0", tolerance_ns));
@@ -31,11 +33,28 @@ void TriggerMatcher::expect(const Trigger& trigger) {
 std::optional<TriggerMatcher::Match> TriggerMatcher::match(std::uint64_t frame_id, std::int64_t timestamp_ns,
                                                            std::optional<Exposure> burst_position) {
   std::lock_guard lock(mutex_);
+  // The counter's parity, corrected once time showed it off by one.
+  if (burst_position && parity_flipped_) burst_position = *burst_position == Exposure::A ? Exposure::B : Exposure::A;
   // Frame B of a double-frame camera: the frame right after its trigger's frame A.
   if (open_pair_) {
     const Trigger pair = *open_pair_;
     open_pair_.reset();
-    if (frame_id == open_pair_frame_id_ + 1 && burst_position != Exposure::A) return Match{pair.event, Exposure::B};
+    if (frame_id == open_pair_frame_id_ + 1) {
+      if (burst_separation_ns_ > 0) {
+        // Time decides: B follows A by the burst separation; the next burst's A a period later.
+        const bool is_b =
+            std::llabs(timestamp_ns - open_pair_timestamp_ns_ - burst_separation_ns_) <= tolerance_ns_;
+        if (burst_position && (*burst_position == Exposure::B) != is_b) {
+          parity_flipped_ = !parity_flipped_;
+          burst_position = is_b ? Exposure::B : Exposure::A;
+          // The frame taken for the pair's A was a B: its offset is off by the separation.
+          if (!is_b && open_pair_taught_ && !offsets_[0].empty()) offsets_[0].pop_back();
+        }
+        if (is_b) return Match{pair.event, Exposure::B};
+      } else if (burst_position != Exposure::A) {
+        return Match{pair.event, Exposure::B};
+      }
+    }
   }
   const bool lone_b = frames_per_trigger_ == 2 && burst_position == Exposure::B;
   if (pending_.empty()) {
@@ -96,8 +115,17 @@ std::optional<TriggerMatcher::Match> TriggerMatcher::match(std::uint64_t frame_i
   if (frames_per_trigger_ == 2) {
     open_pair_ = hit;
     open_pair_frame_id_ = frame_id;
+    open_pair_timestamp_ns_ = timestamp_ns;
+    open_pair_taught_ = hit.event.has_value() && hit.exposure == Exposure::A;
   }
   return Match{hit.event, hit.exposure};
+}
+
+void TriggerMatcher::relearn_offsets() {
+  std::lock_guard lock(mutex_);
+  offsets_[0].clear();
+  offsets_[1].clear();
+  misses_in_a_row_ = 0;
 }
 
 std::uint64_t TriggerMatcher::triggers_lost() const {

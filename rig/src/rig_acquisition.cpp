@@ -9,6 +9,7 @@
 
 #include <fmt/core.h>
 
+#include "tomorig/rig/buffer_memory.h"
 #include "tomorig/rig/simulate_session.h"
 #include "tomorig/acquisition/aravis_camera.h"
 #include "tomorig/acquisition/gentl_camera.h"
@@ -137,18 +138,30 @@ RigAcquisition::RigAcquisition(const config::RigConfig& rig, RigAcquisitionOptio
     // With a simulated trigger device nothing fires the cameras' trigger lines, so the loop
     // sends software triggers; a hardware trigger device drives the lines itself.
     software_triggers_ = rig_.trigger.backend == config::TriggerBackend::simulated;
+    // Frames wait in the assembler while a set waits for a late or lost frame (up to the set
+    // timeout), and every camera's frames of the sets queued behind it wait too: the pool
+    // must outlast that, or one camera's loss becomes every camera's underrun.
+    const double set_timeout_s = std::chrono::duration<double>(options_.set_timeout).count();
+    const int buffers = std::max(acquisition::AravisCameraOptions{}.buffer_count,
+                                 static_cast<int>(std::ceil(2.0 * plan_.rate_hz * (set_timeout_s + kQueueAllowance.count()))) +
+                                     kSpareBuffers);
+    // The pools' memory is checked before any camera is opened when the rig file gives every
+    // camera's size, else after configure() with the size the cameras report.
+    std::vector<CameraBufferPool> pools;
+    for (const auto& cam : rig_.cameras)
+      if (cam.roi.width > 0 && cam.roi.height > 0)
+        pools.push_back({cam.id, buffers,
+                         static_cast<std::size_t>(cam.roi.width) * static_cast<std::size_t>(cam.roi.height) *
+                             bytes_per_sample(sample_type_of(cam.pixel_format))});
+    const bool sizes_known = pools.size() == rig_.cameras.size();
+    if (sizes_known) check_buffer_memory(pools, plan_.rate_hz, set_timeout_s, memory_available_bytes());
     for (const auto& cam : rig_.cameras) {
       // The camera takes the plan: its frame mode, trigger source and the exposure.
       acquisition::AravisCameraOptions aravis;
       aravis.frame_mode = cam.frame_mode;
       if (software_triggers_) aravis.trigger_source = "Software";
       aravis.exposure_time_us = static_cast<double>(plan_.camera.exposure_a_ns) / 1000.0;
-      // Frames wait in the assembler while a set waits for a late or lost frame (up to the set
-      // timeout), and every camera's frames of the sets queued behind it wait too: the pool
-      // must outlast that, or one camera's loss becomes every camera's underrun.
-      const double waiting_s = std::chrono::duration<double>(options_.set_timeout).count() + kQueueAllowance.count();
-      aravis.buffer_count = std::max(aravis.buffer_count,
-                                     static_cast<int>(std::ceil(2.0 * plan_.rate_hz * waiting_s)) + kSpareBuffers);
+      aravis.buffer_count = buffers;
       if (software_triggers_) {
         // Frames answer triggers a period apart (hardware) or Δt and the rest of the period
         // apart (two_triggers): half the closer spacing tells them apart.
@@ -157,6 +170,8 @@ RigAcquisition::RigAcquisition(const config::RigConfig& rig, RigAcquisitionOptio
                                          ? std::min(separation, plan_.period_ns - separation)
                                          : plan_.period_ns;
         aravis.match_tolerance_ns = closest / 2;
+        if (cam.frame_mode == config::FrameMode::hardware) aravis.burst_separation_ns = separation;
+        if (cam.frame_mode == config::FrameMode::two_triggers) aravis.readout_ns = plan_.camera.readout_ns;
       }
       // GenTL cameras (frame grabbers) are Aravis-engine cameras reached through a producer.
       auto camera = cam.backend == config::CameraBackend::gentl ? acquisition::make_gentl_camera(cam.id, aravis)
@@ -165,6 +180,12 @@ RigAcquisition::RigAcquisition(const config::RigConfig& rig, RigAcquisitionOptio
       session_cameras_.push_back({cam.id, cam.roi.width, cam.roi.height, cam.pixel_format, cam.pixel_pitch_um});
       aravis_cameras_.push_back(camera.get());
       cameras_.push_back(std::move(camera));
+    }
+    if (!sizes_known) {
+      pools.clear();
+      for (std::size_t c = 0; c < aravis_cameras_.size(); ++c)
+        pools.push_back({camera_ids_[c], buffers, aravis_cameras_[c]->payload_bytes()});
+      check_buffer_memory(pools, plan_.rate_hz, set_timeout_s, memory_available_bytes());
     }
   }
 

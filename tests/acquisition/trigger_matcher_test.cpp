@@ -118,9 +118,59 @@ TEST(TriggerMatcher, ALoneFrameBKeepsItsRoleAndTrigger) {
   EXPECT_EQ(blind.match(1, kCameraClock + 300'000)->exposure, Exposure::A);
 }
 
+// A double-frame camera whose very first frame never reached the host: the frame counter's
+// parity (taken from the first frame received) calls every later frame A a B and every B an A.
+// With the plan's burst separation the matcher sees that the frame after the first is not its
+// B (it comes a period later, not 1 ms): the parity flips back, and from the second event on
+// every frame has its own role and event (before: every frame A became B of the event before).
+TEST(TriggerMatcher, AFirstFrameLostEntirelyDoesNotSwapTheRolesOfTheRun) {
+  constexpr std::int64_t kSeparation = 1 * kMs;  // frame B 1 ms after frame A
+  constexpr std::int64_t kLatency = 7 * kMs;
+  TriggerMatcher m(2, 100 * kMs, kSeparation);
+  constexpr std::uint64_t kEvents = 6;
+  for (std::uint64_t k = 0; k < kEvents; ++k) m.expect({k, Exposure::A, static_cast<std::int64_t>(k) * 200 * kMs});
+  // The camera counts from 500: event k's frames are ids 500 + 2k (A) and 501 + 2k (B). Id 500
+  // never arrives, so the caller's parity (sequence since the first frame received) is wrong.
+  std::uint64_t sequence = 0;
+  for (std::uint64_t k = 0; k < kEvents; ++k) {
+    for (const Exposure e : {Exposure::A, Exposure::B}) {
+      if (k == 0 && e == Exposure::A) continue;  // lost entirely
+      const std::uint64_t id = 500 + 2 * k + (e == Exposure::B ? 1 : 0);
+      const std::int64_t time = kCameraClock + static_cast<std::int64_t>(k) * 200 * kMs + kLatency +
+                                (e == Exposure::B ? kSeparation : 0);
+      const Exposure parity = sequence++ % 2 == 0 ? Exposure::A : Exposure::B;
+      const auto hit = m.match(id, time, parity);
+      if (k == 0) continue;  // the lone first frame: nothing yet tells A from B
+      ASSERT_TRUE(hit) << "event " << k;
+      EXPECT_EQ(hit->event, k) << "id " << id;
+      EXPECT_EQ(hit->exposure, e) << "id " << id;
+    }
+  }
+  EXPECT_EQ(m.triggers_lost(), 0u);
+}
+
+// The camera's triggers move to another phase of its readout grid (two_triggers, see
+// AravisCameraOptions::readout_ns): its offset grows by 35 ms. Relearnt, the next frames
+// answer their own triggers; with the stale offset, a frame that also crossed a grid line
+// (+40 ms) would pass for the next trigger's.
+TEST(TriggerMatcher, RelearntOffsetsFollowAShiftedPhase) {
+  TriggerMatcher m(1, 40 * kMs);
+  expect_events(m, 3);  // A at 200k, B at 200k + 60 ms
+  EXPECT_EQ(m.match(0, kCameraClock + 2 * kMs)->event, 0u);
+  EXPECT_EQ(m.match(1, kCameraClock + 62 * kMs)->exposure, Exposure::B);
+  m.relearn_offsets();
+  // Event 1's frame A 35 ms later than before plus a 40 ms grid crossing: 77 ms after its
+  // trigger, 17 ms after frame B's trigger plus the old offset.
+  const auto a1 = m.match(2, kCameraClock + 200 * kMs + 77 * kMs);
+  ASSERT_TRUE(a1);
+  EXPECT_EQ(a1->event, 1u);
+  EXPECT_EQ(a1->exposure, Exposure::A);
+}
+
 TEST(TriggerMatcher, OptionsAreChecked) {
   EXPECT_THROW(TriggerMatcher(3, kMs), Error);
   EXPECT_THROW(TriggerMatcher(1, 0), Error);
+  EXPECT_THROW(TriggerMatcher(2, kMs, -1), Error);
 }
 
 }  // namespace

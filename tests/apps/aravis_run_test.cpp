@@ -61,6 +61,19 @@ std::string fmt_lost(const storage::SessionReader& session) {
          " incomplete sets";
 }
 
+// The frames a camera delivered, from the last status line ("camA connected 50 frames, ..."):
+// every frame that reached tomorig, including pairs the pair check dropped afterwards.
+long frames_delivered(const std::string& err, const std::string& camera) {
+  std::size_t best = std::string::npos;
+  for (const char* state : {" connected ", " DISCONNECTED "}) {
+    const std::size_t at = err.rfind(camera + state);
+    if (at != std::string::npos && (best == std::string::npos || at > best)) best = at;
+  }
+  if (best == std::string::npos) return -1;
+  const std::size_t number = err.find_first_of("0123456789", best + camera.size());
+  return number == std::string::npos ? -1 : std::atol(err.c_str() + number);
+}
+
 bool run_quietly(const std::string& command) { return std::system((command + " >/dev/null 2>&1").c_str()) == 0; }
 
 // Whether a UDP socket is bound to `address`:3956 (GVCP), from /proc/net/udp ("0100007F:0F74").
@@ -168,6 +181,51 @@ void expect_pairs_from_their_own_events(const storage::SessionReader& session, i
   EXPECT_LT(*hi - *lo, 100'000'000) << "camera " << camera << ": a frame A belongs to another trigger event";
 }
 
+// The plan-sized buffer pools are checked against the memory available before any camera is
+// opened: four 2048 x 2048 Mono16 cameras at 5 Hz hold 4 x 18 buffers of 8.4 MB (604 MB). A
+// meminfo file (TOMORIG_MEMINFO, the documented test seam) says 512 MB are available: refused,
+// exit 2, with the figures and the fix; no camera is touched (the device ids name no camera).
+class RigBufferMemory : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!tomorig_built()) GTEST_SKIP() << "the tomorig binary is not built";
+    std::string big = rig_toml("two_triggers");
+    for (std::string::size_type at; (at = big.find("width = 64\nheight = 48")) != std::string::npos;)
+      big.replace(at, 22, "width = 2048\nheight = 2048");
+    for (std::string::size_type at; (at = big.find("\"Mono8\"")) != std::string::npos;) big.replace(at, 7, "\"Mono16\"");
+    for (std::string::size_type at; (at = big.find("device_id = \"127.0.0.")) != std::string::npos;)
+      big.replace(at, 22, "device_id = \"192.0.2.");  // TEST-NET-1: no camera answers there
+    std::ofstream(dir_ / "big.toml") << big;
+  }
+  void TearDown() override { unsetenv("TOMORIG_MEMINFO"); }
+  CliResult run_with_available_kb(std::uint64_t kilobytes) {
+    std::ofstream(dir_ / "meminfo") << "MemTotal:       99999999 kB\nMemFree:          100000 kB\nMemAvailable:   "
+                                    << kilobytes << " kB\n";
+    setenv("TOMORIG_MEMINFO", (dir_ / "meminfo").c_str(), 1);
+    return run_tomorig("run --config " + shell_quoted((dir_ / "big.toml").string()) + " --sets 5 --status none -o " +
+                       shell_quoted((dir_ / "big.h5").string()));
+  }
+  TempDir dir_;
+};
+
+TEST_F(RigBufferMemory, PoolsLargerThanTheMemoryAvailableAreRefusedBeforeAnyCameraIsOpened) {
+  const CliResult r = run_with_available_kb(500'000);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  for (const char* part : {"0.60 GB", "0.51 GB available", "4 cameras x 18 buffers", "8.4 MB", "rate_hz 5",
+                           "set timeout 0.5 s", "Lower [trigger] rate_hz", "[cameras.roi]"})
+    EXPECT_NE(r.err.find(part), std::string::npos) << part << " in: " << r.err;
+  EXPECT_EQ(r.err.find("not found"), std::string::npos) << "no camera may be opened: " << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "big.h5"));
+  EXPECT_FALSE(std::filesystem::exists((dir_ / "big.h5").string() + ".partial"));
+}
+
+TEST_F(RigBufferMemory, PoolsThatFitPassTheCheckAndTheRunGoesOnToOpenTheCameras) {
+  const CliResult r = run_with_available_kb(8'000'000);  // 8 GB: 604 MB fit
+  EXPECT_EQ(r.err.find("camera buffers need"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("camera camA"), std::string::npos) << r.err;  // the absent camera is what stops it
+  EXPECT_NE(r.exit_code, 0);
+}
+
 TEST_F(GigEFakeRig, TwoTriggersASetGiveCompleteSetsWhosePairsComeFromOneEvent) {
   constexpr int kSets = 20;
   write_rig(rig_toml("two_triggers"));
@@ -180,11 +238,19 @@ TEST_F(GigEFakeRig, TwoTriggersASetGiveCompleteSetsWhosePairsComeFromOneEvent) {
   EXPECT_TRUE(session.recording_complete());
   // The fake looks for a trigger only on a 40 ms grid of the wall clock, so its B - A is 80 ms
   // or, when the host's scheduling delays a trigger across a grid line, 40 or 120 ms: that pair
-  // is dropped (its set flagged), never kept across events. On a quiet machine that is rare
-  // (the 200-set run of docs/acquisition.md); on a 2-core machine shared with compilers it
-  // happens in bursts, so here the check is that most sets are complete and every pair kept
-  // is right (below).
+  // is dropped (its set flagged), never kept across events. Once each camera has learned its
+  // answer latency (4 events), its triggers go out just past the grid line, with 35 ms to spare
+  // (AravisCameraOptions::readout_ns): on a 2-core machine running four compilers (load 13-16)
+  // 20- to 60-set runs then flagged 0-2 sets, once 6 of 20 (the fakes themselves starved),
+  // where a third and more were flagged before. The bound stays at a third for such machines;
+  // the frames-delivered check below is the strict one.
   EXPECT_LE(session.incomplete_sets(), kSets / 3) << r.err;
+  // Every trigger is answered by a frame: a trigger the fake merged with the next one or lost
+  // (it sleeps through a grid line now and then; the camera nudges it) is a frame that never
+  // comes, unlike a grid crossing, whose frames come and are dropped by the pair check. On a
+  // quiet machine all 40 come; a host so busy that the fake's own thread waits more than a
+  // trigger spacing can still merge one.
+  for (int c = 0; c < kFakes; ++c) EXPECT_GE(frames_delivered(r.err, kCameraIds[c]), 2 * kSets - 2) << r.err;
   EXPECT_NE(r.out.find(fmt_lost(session)), std::string::npos) << r.out;
   for (std::uint64_t k = 0; k < session.set_count(); ++k) {
     const storage::SetRecord rec = session.set_record(k);
@@ -196,6 +262,41 @@ TEST_F(GigEFakeRig, TwoTriggersASetGiveCompleteSetsWhosePairsComeFromOneEvent) {
   }
   for (int c = 0; c < kFakes; ++c) expect_pairs_from_their_own_events(session, c);
   EXPECT_EQ(session.read_set(0).cameras[3].camera_id, "camD");
+}
+
+// frame_mode "free_run": the fakes stream at their own 25 Hz, unsynchronised. Allowed, with a
+// warning on every status line; their frames fill the sets marked unsynchronised
+// (frame_present 2 in the file), and no set is ever called complete; the run ends normally.
+TEST_F(GigEFakeRig, FreeRunningCamerasAreWarnedAboutOnEveryLineAndNoSetIsComplete) {
+  constexpr int kSets = 10;
+  write_rig(rig_toml("free_run"));
+  const auto out = dir_ / "free.h5";
+  CliResult r = run_tomorig("run --config " + shell_quoted(rig_.string()) + " --sets " + std::to_string(kSets) +
+                            " --status none -o " + shell_quoted(out.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  int status_lines = 0;
+  std::istringstream lines(r.err);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find("recording: set ") == std::string::npos) continue;
+    ++status_lines;
+    EXPECT_NE(line.find("WARNING free-running cameras camA, camB, camC, camD"), std::string::npos) << line;
+  }
+  EXPECT_GE(status_lines, 2) << r.err;  // the closing line at least, and one during the run
+  const storage::SessionReader session(out);
+  ASSERT_EQ(session.set_count(), static_cast<std::uint64_t>(kSets));
+  EXPECT_EQ(session.incomplete_sets(), static_cast<std::uint64_t>(kSets));
+  int unsynchronised = 0;
+  for (std::uint64_t k = 0; k < session.set_count(); ++k) {
+    const storage::SetRecord rec = session.set_record(k);
+    for (int c = 0; c < kFakes; ++c)
+      for (int e = 0; e < 2; ++e) {
+        if (!rec.frame_present[c][e]) continue;
+        EXPECT_FALSE(rec.frame_synchronised[c][e]) << "set " << k << " camera " << c;
+        ++unsynchronised;
+      }
+  }
+  // The fakes stream at 25 Hz, five frames a 5 Hz set: most slots are filled.
+  EXPECT_GE(unsynchronised, kSets * kFakes * 2 / 2) << r.err;
 }
 
 TEST_F(GigEFakeRig, HardwareModeOnSingleFrameCamerasIsRefusedBeforeAnythingRuns) {
@@ -257,13 +358,16 @@ TEST_F(GigEFakeRig, AKilledCameraIsNamedAndContinueFinishesTheRunWithItsFramesMi
     for (int c : {0, 1, 3}) others_missing += !rec.frame_present[c][0] + !rec.frame_present[c][1];
     if (!rec.frame_present[2][0] || !rec.frame_present[2][1]) ++flagged;
   }
-  // camC's frames are missing from the kill on; the other cameras keep recording (a frame of
-  // theirs the fake answered off its 40 ms grid may be left out, see above). Usually 0-5 of
-  // their 150 frames are; one clean-clone CI run on a quiet machine (session 7) lost 32 after the
-  // kill, which is not understood yet (issue 13's notes): the bound says only that the other
-  // cameras kept recording, at least two frames in three.
+  // camC's frames are missing from the kill on; the other cameras keep being triggered and
+  // answer every trigger: each delivers its 50 frames, 2 at most short of that (each camera
+  // has its own trigger thread, so the dead camera's unanswered commands hold up no other
+  // camera; a host too busy for the fakes may merge a trigger, see the first test). Their
+  // pairs in the file may miss a few more: the pair check drops the pairs a busy host pushed
+  // across the fake's 40 ms grid, before the kill as much as after it (the first test), at
+  // most one frame in five.
   EXPECT_GE(flagged, kSets - kKillAfter - 2);
-  EXPECT_LE(others_missing, kSets * 2 * 3 / 3);
+  for (int c : {0, 1, 3}) EXPECT_GE(frames_delivered(run.err(), kCameraIds[c]), 2 * kSets - 2) << run.err();
+  EXPECT_LE(others_missing, kSets * 2 * 3 / 5) << run.err();
   for (int c : {0, 1, 3}) expect_pairs_from_their_own_events(session, c);
 }
 

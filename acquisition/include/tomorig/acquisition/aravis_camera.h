@@ -47,6 +47,17 @@ struct AravisCameraOptions {
   // (TriggerMatcher) within this tolerance, below half the closest spacing of two triggers;
   // 0: frames are counted instead (frame k of the stream is set k / 2 since start).
   std::int64_t match_tolerance_ns = 0;
+  // frame_mode hardware with match_tolerance_ns: frame B's time after frame A's by the plan, so
+  // the frames' roles come from time (TriggerMatcher), not from the frame counter's parity alone.
+  std::int64_t burst_separation_ns = 0;
+  // frame_mode two_triggers with software triggers: the camera's readout time (the plan's
+  // readout_us; 0: unknown). A camera that takes a trigger only at the end of its readout (a
+  // frame grid, like Aravis's GigE fake) answers it at the next grid line: a trigger sent just
+  // before one moves a whole readout later with the smallest host delay, and its pair is lost.
+  // Once the camera's answer latency is learned and is under half the readout, the
+  // camera's triggers are sent that latency plus an eighth of the readout later, just after
+  // the grid line: a delay then has most of a readout to spare.
+  std::int64_t readout_ns = 0;
   int packet_size = 0;                      // GigE GevSCPSPacketSize in bytes; 0: camera's value
   int socket_buffer_bytes = 0;              // GigE receive socket buffer; 0: Aravis default
   // GigE: how long an incomplete frame waits for missing packets before it fails (Aravis
@@ -105,6 +116,8 @@ class AravisCamera final : public Camera {
   // Trigger pulses the camera needs per double-frame set: 1 (hardware), 2 (two_triggers),
   // 0 (free_run).
   int triggers_per_set() const;
+  // Bytes of one frame as the configured camera reports them (0 before configure()).
+  std::size_t payload_bytes() const;
 
  private:
   struct Impl;

@@ -37,7 +37,13 @@ class TriggerMatcher {
   // frames_per_trigger: 1 (two_triggers) or 2 (hardware: frame B follows frame A by id).
   // tolerance_ns: how far a frame's timestamp may be from where the trigger spacing puts it;
   // below half the closest spacing of two triggers. Throws bad_input otherwise out of range.
-  TriggerMatcher(int frames_per_trigger, std::int64_t tolerance_ns);
+  // burst_separation_ns (frames_per_trigger 2, 0: unknown): frame B's time after frame A's by
+  // the plan. With it the roles come from time, not from the frame counter's parity alone: a
+  // frame right after a frame A is its B only if it follows it by that separation (within the
+  // tolerance). A burst whose frame A never reached the host at all (the very first frame of a
+  // run, say) would otherwise flip the parity of every later frame; the first frame that
+  // contradicts the parity flips it back (and that mistaken frame A's offset is forgotten).
+  TriggerMatcher(int frames_per_trigger, std::int64_t tolerance_ns, std::int64_t burst_separation_ns = 0);
 
   void expect(const Trigger& trigger);  // in the order the triggers are sent; thread-safe
   // The trigger `frame_id` (unwrapped frame counter) with camera timestamp `timestamp_ns`
@@ -49,6 +55,11 @@ class TriggerMatcher {
   // that is not the id after an open frame A is taken for a frame A.
   std::optional<Match> match(std::uint64_t frame_id, std::int64_t timestamp_ns,
                              std::optional<Exposure> burst_position = std::nullopt);
+
+  // Forgets the learned clock offsets: the camera's answer latency is about to change (its
+  // triggers move to another phase of its readout). The next frame answers the oldest pending
+  // trigger, as at the start. Thread-safe.
+  void relearn_offsets();
 
   std::uint64_t triggers_lost() const;   // passed over: their frames never came
   std::uint64_t frames_unmatched() const;
@@ -63,8 +74,12 @@ class TriggerMatcher {
   // grid falls 20 ms later for a trigger sent 60 ms after the first).
   std::deque<std::int64_t> offsets_[2];
   int misses_in_a_row_ = 0;
+  std::int64_t burst_separation_ns_ = 0;
   std::optional<Trigger> open_pair_;   // frames_per_trigger 2: the trigger whose frame B is next
   std::uint64_t open_pair_frame_id_ = 0;
+  std::int64_t open_pair_timestamp_ns_ = 0;
+  bool open_pair_taught_ = false;      // its frame A added an offset (offsets_[0].back())
+  bool parity_flipped_ = false;        // the frame counter's parity says the opposite role
   std::uint64_t lost_ = 0;
   std::uint64_t unmatched_ = 0;
 };
