@@ -210,4 +210,60 @@ Image render_bright_field(const SprayCase& c, std::size_t camera, std::uint64_t 
   return digitise_camera(c, camera, signal, derive_seed(c.options.seed, {kBrightStream, frame, camera, 7}));
 }
 
+Image render_spray_edge_target(const SprayCase& c, std::size_t camera, double z_mm, std::uint64_t frame,
+                               double slant_deg) {
+  const SprayCamera& cam = c.cameras.at(camera);
+  const double level = c.options.bright_fraction * 65535.0;
+  const double energy = pulse_energy(c, kBrightStream, frame + 1000003, camera, 1);
+  constexpr double kChromium = 0.05;
+  const double cs = std::cos(slant_deg * M_PI / 180.0), sn = std::sin(slant_deg * M_PI / 180.0);
+  // The PSF lives in the image: the same sigma in pixels as a droplet at this depth gets
+  // (project() in render_spray_set), the pixel box added by sub-sampling below.
+  const Vec3d centre{0.0, 0.0, z_mm};
+  const double object_pixel_um = cam.pixel_pitch_um / cam.pinhole.magnification(centre, cam.pixel_pitch_um);
+  const double chi_px = spray_chi_um(cam, z_mm) / object_pixel_um;
+  const double sigma_px = std::sqrt(std::max(0.25 * chi_px * chi_px - 1.0 / 12.0, 1e-4));
+  const double k = 1.0 / (std::sqrt(2.0) * sigma_px);
+  // The bars cover a band of the mask 30 % of the image high (the rest is clear glass): enough
+  // rows for every edge, at a third of the rendering time.
+  const int band0 = static_cast<int>(0.35 * cam.height), band1 = static_cast<int>(0.65 * cam.height);
+  // s = the plane coordinate across the bars (mm) at every pixel centre of the band.
+  const int w = cam.width;
+  std::vector<double> across(static_cast<std::size_t>(w) * (band1 - band0 + 2));
+  for (int y = band0; y <= band1 + 1; ++y)
+    for (int x = 0; x < w; ++x) {
+      const Vec3d p = cam.pinhole.back_project({double(x), double(y)}, z_mm);
+      across[static_cast<std::size_t>(y - band0) * w + x] = p.x * cs - p.y * sn;
+    }
+  Image signal = Image::allocate(cam.width, cam.height, SampleType::f32);
+  constexpr int kSub = 4;  // 4 x 4 samples over each pixel's area
+#pragma omp parallel for num_threads(detail::thread_count(c.options.threads)) schedule(static)
+  for (int y = 0; y < cam.height; ++y) {
+    float* row = signal.row<float>(y);
+    for (int x = 0; x < w; ++x) {
+      double mask = 1.0;
+      if (y >= band0 && y <= band1 && x + 1 < w) {
+        // s is linear over a pixel; its gradient (mm per pixel) converts plane distances to pixels.
+        const double s0 = across[static_cast<std::size_t>(y - band0) * w + x];
+        const double du = across[static_cast<std::size_t>(y - band0) * w + x + 1] - s0;
+        const double dv = across[static_cast<std::size_t>(y + 1 - band0) * w + x] - s0;
+        const double mm_per_px = std::hypot(du, dv);
+        double sum = 0.0;
+        for (int j = 0; j < kSub; ++j)
+          for (int i = 0; i < kSub; ++i) {
+            const double s = s0 + ((i + 0.5) / kSub - 0.5) * du + ((j + 0.5) / kSub - 0.5) * dv;
+            // Light on [0, 1) mm of each 2 mm period; the bars are far wider than the blur, so
+            // only the nearest edge counts: Phi(signed distance in pixels / sigma).
+            const double q = s - 2.0 * std::floor(s / 2.0);
+            const double d_mm = q < 1.0 ? std::min(q, 1.0 - q) : -std::min(q - 1.0, 2.0 - q);
+            sum += 0.5 * (1.0 + std::erf(d_mm / mm_per_px * k));
+          }
+        mask = kChromium + (1.0 - kChromium) * sum / (kSub * kSub);
+      }
+      row[x] = static_cast<float>(energy * bright_field(cam, level, c.options.vignetting, x, y) * mask);
+    }
+  }
+  return digitise_camera(c, camera, signal, derive_seed(c.options.seed, {kBrightStream, frame, camera, 11}));
+}
+
 }  // namespace tomorig::sim

@@ -100,6 +100,13 @@ SpraySet render_spray_set(const SprayCase& c, std::uint64_t set_index);
 // A bright-field frame without spray (camera c, frame k of a bright-field series), with the
 // same light, pulse variation and noise: for the threshold of visibility (Sect. 6.4).
 Image render_bright_field(const SprayCase& c, std::size_t camera, std::uint64_t frame);
+// A calibration image for the knife-edge PSF (Sect. 6.4): a back-lit photomask of bars, 1 mm
+// clear and 1 mm chromium (5 % transmission) over a band 30 % of the image high, slanted by
+// `slant_deg` from the world y axis, on the plane z = z_mm, seen through camera c's PSF at that
+// depth (the image-space blur and pixel integration the droplets get), with the bright field
+// and noise of frame `frame`.
+Image render_spray_edge_target(const SprayCase& c, std::size_t camera, double z_mm, std::uint64_t frame,
+                               double slant_deg = 4.0);
 // The PSF half-width of camera c at world depth z (object um), linearly interpolated in the
 // truth samples (clamped at the ends).
 double spray_chi_um(const SprayCamera& cam, double z_mm);
