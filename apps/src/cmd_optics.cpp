@@ -2,6 +2,7 @@
 //   tomorig optics visibility --setup optics.toml [--json] [--png plot.png] [--overwrite]
 //   tomorig optics visibility --f-number 22 --magnification 0.9 --chi -4.5:62,0:40,4.5:60 --noise 0.01
 //   tomorig optics transmission --f-number 22 --magnification 0.9 --d 5,10,20,50 [--chi 40]
+//   tomorig optics psf --session targets.h5 [--z LIST] [--magnification LIST] [--json]
 #include <cmath>
 #include <memory>
 #include <string>
@@ -14,11 +15,13 @@
 #include "commands.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/optics/droplet_image.h"
+#include "tomorig/processing/optics/edge_psf.h"
 #include "tomorig/processing/optics/optics_setup.h"
 #include "tomorig/processing/optics/visibility.h"
 #include "tomorig/processing/optics/visibility_plot.h"
 #include "tomorig/storage/image_file.h"
 #include "tomorig/storage/output_path.h"
+#include "tomorig/storage/session_file.h"
 
 namespace tomorig::app {
 namespace {
@@ -192,6 +195,83 @@ void run_transmission(const OpticsArgs& a) {
   }
 }
 
+struct PsfArgs {
+  std::string session, z, magnification;
+  bool json = false;
+};
+
+// Object-space size (um) of one pixel of camera c at depth z: from the session's truth camera
+// (pinhole: depth along the axis / fx) when there is one, else pixel pitch / magnification.
+double object_pixel_um(const storage::SessionReader& reader, const std::vector<double>& magnification, std::size_t c,
+                       double z_mm) {
+  if (!magnification.empty()) return reader.info().cameras[c].pixel_pitch_um / magnification[c];
+  const storage::SessionTruth truth = reader.truth();
+  const storage::TruthCamera& t = truth.cameras.at(c);
+  const double depth = t.R[8] * z_mm + t.t.z;  // (R p + t).z for p = (0, 0, z); R row-major
+  return depth / t.K[0] * 1000.0;
+}
+
+void run_psf(const PsfArgs& a) {
+  const storage::SessionReader reader(a.session);
+  const std::size_t sets = reader.set_count(), cams = reader.info().cameras.size();
+  if (sets == 0) throw bad_input(fmt::format("session '{}' has no sets: record one target image per depth", a.session));
+  std::vector<double> z, m;
+  if (!a.z.empty()) {
+    for (const std::string& t : split(a.z, ',')) z.push_back(number(t, "--z"));
+  } else if (reader.has_truth()) {
+    const nlohmann::json p = nlohmann::json::parse(reader.truth().flow_parameters, nullptr, false);
+    if (p.is_object() && p.contains("planes"))
+      for (const auto& plane : p["planes"])
+        if (plane.contains("z_mm")) z.push_back(plane["z_mm"].get<double>());
+  }
+  if (z.size() != sets)
+    throw bad_input(fmt::format("--z: give one depth (mm) per set of '{}' ({} sets, {} depths given)", a.session, sets,
+                                z.size()));
+  if (!a.magnification.empty()) {
+    for (const std::string& t : split(a.magnification, ',')) m.push_back(number(t, "--magnification"));
+    if (m.size() == 1) m.assign(cams, m[0]);
+    if (m.size() != cams) throw bad_input(fmt::format("--magnification: give one value, or one per camera ({})", cams));
+    for (double v : m)
+      if (!(v > 0)) throw bad_input(fmt::format("--magnification {} must be > 0", v));
+  } else if (!reader.has_truth() || reader.truth().cameras.size() != cams) {
+    throw bad_input("--magnification is required: the session has no camera truth to convert pixels to um");
+  }
+  // chi[c][k]
+  std::vector<std::vector<double>> chi(cams, std::vector<double>(sets, std::nan("")));
+  std::vector<std::vector<int>> edges(cams, std::vector<int>(sets, 0));
+  for (std::size_t k = 0; k < sets; ++k) {
+    const FrameSet set = reader.read_set(k);
+    for (std::size_t c = 0; c < cams && c < set.cameras.size(); ++c) {
+      if (!set.cameras[c].a.present()) continue;
+      try {
+        const optics::EdgePsf psf = optics::measure_edge_psf(set.cameras[c].a.image);
+        chi[c][k] = psf.chi_px * object_pixel_um(reader, m, c, z[k]);
+        edges[c][k] = static_cast<int>(psf.edges.size());
+      } catch (const Error& e) {
+        fmt::print(stderr, "set {} ({} mm), camera '{}': {}\n", k, z[k], reader.info().cameras[c].id, e.what());
+      }
+    }
+  }
+  if (a.json) {
+    nlohmann::json out = nlohmann::json::array();
+    for (std::size_t c = 0; c < cams; ++c) {
+      nlohmann::json values = nlohmann::json::array();
+      for (double v : chi[c]) values.push_back(finite_or_null(v));
+      out.push_back({{"id", reader.info().cameras[c].id}, {"z_mm", z}, {"chi_um", values}, {"edges", edges[c]}});
+    }
+    fmt::print("{}\n", nlohmann::json{{"session", a.session}, {"cameras", out}}.dump(2));
+    return;
+  }
+  fmt::print("PSF half-width chi [um] from edges (knife-edge, Gaussian fit of the line spread)\n{:>8}", "z [mm]");
+  for (std::size_t c = 0; c < cams; ++c) fmt::print(" {:>8}", reader.info().cameras[c].id);
+  fmt::print("\n");
+  for (std::size_t k = 0; k < sets; ++k) {
+    fmt::print("{:>8.2f}", z[k]);
+    for (std::size_t c = 0; c < cams; ++c) fmt::print(" {:>8}", cell(chi[c][k]));
+    fmt::print("\n");
+  }
+}
+
 void add_common(CLI::App* cmd, OpticsArgs& a) {
   cmd->add_option("--setup", a.setup, "optics set-up file (TOML, docs/spray.md): liquid, LED, cameras with chi(z)");
   a.f_opt = cmd->add_option("--f-number", a.f_number, "lens f-number (one camera, instead of --setup)");
@@ -225,6 +305,17 @@ void add_optics_command(CLI::App& root) {
   add_common(t, *tr);
   t->add_option("--d", tr->diameters, "droplet diameters in um, comma-separated");
   t->callback([tr] { run_transmission(*tr); });
+
+  auto psf = std::make_shared<PsfArgs>();
+  CLI::App* p = optics_cmd->add_subcommand("psf", "PSF half-width chi per camera and depth from edge-target images "
+                                                  "(knife-edge technique, Sect. 6.4)");
+  p->add_option("--session", psf->session, "session with one set per depth, each camera's target image in exposure A")
+      ->required();
+  p->add_option("--z", psf->z, "depth of each set in mm, comma-separated (default: the session truth's planes)");
+  p->add_option("--magnification", psf->magnification,
+                "magnification, one or one per camera (default: from the session's truth cameras)");
+  p->add_flag("--json", psf->json, "print JSON instead of a table");
+  p->callback([psf] { run_psf(*psf); });
 }
 
 }  // namespace tomorig::app

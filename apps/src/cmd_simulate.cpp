@@ -40,6 +40,7 @@ struct SimulateFlags {
   std::string compression = "none";
   bool overwrite = false;
   bool reduced = false;
+  bool targets = false;
   double distortion_px = sim::CalibTargetOptions{}.distortion_corner_px;
   std::string spray = sim::to_string(sim::SprayOptions{}.pattern);
   // Which optional flags were given: only those override the rig config.
@@ -76,6 +77,11 @@ void run_spray_thesis(const SimulateFlags& f, storage::Compression compression) 
   o.reduced = f.reduced;
   if (f.seed_opt->count()) o.seed = f.seed;
   o.pattern = sim::parse_spray_pattern(f.spray);
+  if (f.targets) {
+    if (f.sets_opt->count()) throw bad_input("--targets renders one set per PSF depth (13): --sets does not apply");
+    fmt::print("{}\n", rig::write_spray_target_session(o, f.out, compression, f.overwrite));
+    return;
+  }
   const int sets = f.sets_opt->count() ? f.sets : 2;
   fmt::print("{}\n", rig::write_spray_session(o, sets, f.out, compression, f.overwrite, [](int done, int total) {
                fmt::print(stderr, "set {}/{} rendered\n", done, total);
@@ -90,7 +96,7 @@ void run_simulate(const SimulateFlags& f) {
 
   if (f.case_opt->count() && f.case_name == "calib-thesis") return run_calib_thesis(f, *compression);
   if (f.case_opt->count() && f.case_name == "spray-thesis") return run_spray_thesis(f, *compression);
-  if (f.spray_opt->count()) throw bad_input("--spray applies to --case spray-thesis only");
+  if (f.spray_opt->count() || f.targets) throw bad_input("--spray and --targets apply to --case spray-thesis only");
   if (f.reduced || f.distortion_opt->count())
     throw bad_input("--reduced applies to --case spray-thesis or calib-thesis only, --distortion-px to calib-thesis only");
 
@@ -172,6 +178,8 @@ void add_simulate_command(CLI::App& root) {
   cmd->add_flag("--reduced", flags->reduced, "calib-thesis, spray-thesis: the reduced 640 x 540 variant (for tests)");
   flags->spray_opt = cmd->add_option("--spray", flags->spray, "spray-thesis: hollow-cone or jet-in-crossflow")
                          ->capture_default_str();
+  cmd->add_flag("--targets", flags->targets,
+                "spray-thesis: the knife-edge calibration series (one set per PSF depth) instead of droplets");
   flags->distortion_opt = cmd->add_option("--distortion-px", flags->distortion_px,
                                           "calib-thesis: radial lens distortion at the image corner, full-size px");
   cmd->callback([flags] { run_simulate(*flags); });

@@ -30,6 +30,104 @@ std::string spray_optics_setup_toml(const sim::SprayCase& c) {
   return t;
 }
 
+namespace {
+
+nlohmann::json cameras_json(const sim::SprayCase& c) {
+  nlohmann::json cams = nlohmann::json::array();
+  for (const sim::SprayCamera& cam : c.cameras) {
+    nlohmann::json z = nlohmann::json::array(), chi = nlohmann::json::array();
+    for (const optics::ChiSample& s : cam.chi) {
+      z.push_back(s.z_mm);
+      chi.push_back(s.chi_um);
+    }
+    cams.push_back({{"id", cam.id},
+                    {"yaw_deg", cam.yaw_deg},
+                    {"magnification", cam.magnification},
+                    {"f_number", cam.f_number},
+                    {"pixel_pitch_um", cam.pixel_pitch_um},
+                    {"noise", cam.noise_sigma},
+                    {"threshold", cam.threshold_value()},
+                    {"z_mm", z},
+                    {"chi_um", chi}});
+  }
+  return cams;
+}
+
+storage::SessionTruth truth_of(const sim::SprayCase& c, const std::string& flow_name, const nlohmann::json& parameters) {
+  storage::SessionTruth truth;
+  truth.case_name = c.name;
+  truth.flow_name = flow_name;
+  truth.flow_parameters = parameters.dump();
+  truth.seed = c.options.seed;
+  for (const sim::SprayCamera& cam : c.cameras) {
+    const auto& p = cam.pinhole.parameters();
+    storage::TruthCamera t;
+    t.id = cam.id;
+    t.K = cam.pinhole.intrinsics();
+    t.R = p.R;
+    t.t = p.t;
+    t.width = cam.width;
+    t.height = cam.height;
+    truth.cameras.push_back(t);
+  }
+  return truth;
+}
+
+storage::SessionInfo info_of(const sim::SprayCase& c, storage::Compression compression, const std::string& comment) {
+  storage::SessionInfo info;
+  for (const sim::SprayCamera& cam : c.cameras)
+    info.cameras.push_back({cam.id, cam.width, cam.height, PixelFormat::Mono16, cam.pixel_pitch_um});
+  info.rig_config_toml = comment;
+  info.software_version = std::string(software_version());
+  info.compression = compression;
+  return info;
+}
+
+}  // namespace
+
+std::string write_spray_target_session(const sim::SprayOptions& options, const std::filesystem::path& out,
+                                       storage::Compression compression, bool overwrite) {
+  storage::check_output_path(out, overwrite, "session");
+  const auto start = std::chrono::steady_clock::now();
+  const sim::SprayCase c = sim::make_spray_thesis_case(options);
+  const std::vector<optics::ChiSample>& depths = c.cameras.front().chi;
+  nlohmann::json planes = nlohmann::json::array();
+  for (std::size_t k = 0; k < depths.size(); ++k) planes.push_back({{"set", k}, {"z_mm", depths[k].z_mm}});
+  const nlohmann::json parameters = {{"target", "bars: 1 mm clear, 1 mm chromium (5 %), slanted 4 deg from y"},
+                                     {"planes", planes},
+                                     {"reduced", c.options.reduced},
+                                     {"cameras", cameras_json(c)},
+                                     {"optics_setup_toml", spray_optics_setup_toml(c)}};
+  storage::SessionWriterOptions wo;
+  wo.compression = compression;
+  wo.overwrite = overwrite;
+  storage::SessionWriter writer(
+      out,
+      info_of(c, compression,
+              "# Written by `tomorig simulate --case spray-thesis --targets`: set k shows a slanted bar photomask at\n"
+              "# depth k (planes[k].z_mm in /truth flow_parameters), for `tomorig optics psf`. No rig config applies.\n"),
+      wo);
+  writer.write_truth(truth_of(c, "traverse", parameters));
+  for (std::size_t k = 0; k < depths.size(); ++k) {
+    FrameSet set;
+    set.set_index = k;
+    set.trigger_index = k;
+    for (std::size_t ci = 0; ci < c.cameras.size(); ++ci) {
+      CameraFrames frames;
+      frames.camera_id = c.cameras[ci].id;
+      frames.a.image = sim::render_spray_edge_target(c, ci, depths[k].z_mm, k);
+      set.cameras.push_back(std::move(frames));
+    }
+    writer.append(set);
+    writer.write_truth_set(k, {});
+  }
+  writer.finish();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return fmt::format("wrote {}: spray-thesis targets{}, {} depths x {} cameras, {} x {} px, seed {}, {:.1f} s", out.string(),
+                     c.options.reduced ? " (reduced)" : "", depths.size(), c.cameras.size(), c.cameras[0].width,
+                     c.cameras[0].height, c.options.seed, seconds);
+}
+
 std::string write_spray_session(const sim::SprayOptions& options, int sets, const std::filesystem::path& out,
                                 storage::Compression compression, bool overwrite,
                                 const std::function<void(int, int)>& progress) {
@@ -64,23 +162,6 @@ std::string write_spray_session(const sim::SprayOptions& options, int sets, cons
     rendered.push_back(std::move(s));
     if (progress) progress(k + 1, sets);
   }
-  nlohmann::json cams = nlohmann::json::array();
-  for (const sim::SprayCamera& cam : c.cameras) {
-    nlohmann::json z = nlohmann::json::array(), chi = nlohmann::json::array();
-    for (const optics::ChiSample& s : cam.chi) {
-      z.push_back(s.z_mm);
-      chi.push_back(s.chi_um);
-    }
-    cams.push_back({{"id", cam.id},
-                    {"yaw_deg", cam.yaw_deg},
-                    {"magnification", cam.magnification},
-                    {"f_number", cam.f_number},
-                    {"pixel_pitch_um", cam.pixel_pitch_um},
-                    {"noise", cam.noise_sigma},
-                    {"threshold", cam.threshold_value()},
-                    {"z_mm", z},
-                    {"chi_um", chi}});
-  }
   const nlohmann::json truth_json = {
       {"pattern", sim::to_string(c.options.pattern)},
       {"reduced", c.options.reduced},
@@ -95,41 +176,22 @@ std::string write_spray_session(const sim::SprayOptions& options, int sets, cons
       {"liquid", c.optics.liquid.name},
       {"led", {{"peak_nm", c.optics.spectrum.peak_nm}, {"fwhm_nm", c.optics.spectrum.fwhm_nm}}},
       {"volume_mm", {{c.volume_min.x, c.volume_min.y, c.volume_min.z}, {c.volume_max.x, c.volume_max.y, c.volume_max.z}}},
-      {"cameras", cams},
+      {"cameras", cameras_json(c)},
       {"visible", "visible_mask bit c: the droplet's own shadow at pulse A reaches camera c's threshold 1 - 2 noise"},
       {"optics_setup_toml", spray_optics_setup_toml(c)},
       {"sets", set_truth}};
 
-  storage::SessionInfo info;
-  for (const sim::SprayCamera& cam : c.cameras)
-    info.cameras.push_back({cam.id, cam.width, cam.height, PixelFormat::Mono16, cam.pixel_pitch_um});
-  info.rig_config_toml = fmt::format(
-      "# Written by `tomorig simulate --case spray-thesis`{}: {} droplets per set, pattern {}; the truth\n"
-      "# (flow_parameters) holds the optics set-up and every droplet. No rig config applies.\n",
-      c.options.reduced ? " --reduced" : "", c.options.droplets, sim::to_string(c.options.pattern));
-  info.software_version = std::string(software_version());
-  info.compression = compression;
   storage::SessionWriterOptions wo;
   wo.compression = compression;
   wo.overwrite = overwrite;
-  storage::SessionWriter writer(out, info, wo);
-  storage::SessionTruth truth;
-  truth.case_name = c.name;
-  truth.flow_name = sim::to_string(c.options.pattern);
-  truth.flow_parameters = truth_json.dump();
-  truth.seed = c.options.seed;
-  for (const sim::SprayCamera& cam : c.cameras) {
-    const auto& p = cam.pinhole.parameters();
-    storage::TruthCamera t;
-    t.id = cam.id;
-    t.K = cam.pinhole.intrinsics();
-    t.R = p.R;
-    t.t = p.t;
-    t.width = cam.width;
-    t.height = cam.height;
-    truth.cameras.push_back(t);
-  }
-  writer.write_truth(truth);
+  storage::SessionWriter writer(
+      out,
+      info_of(c, compression,
+              fmt::format("# Written by `tomorig simulate --case spray-thesis`{}: {} droplets per set, pattern {}; the "
+                          "truth\n# (flow_parameters) holds the optics set-up and every droplet. No rig config applies.\n",
+                          c.options.reduced ? " --reduced" : "", c.options.droplets, sim::to_string(c.options.pattern))),
+      wo);
+  writer.write_truth(truth_of(c, sim::to_string(c.options.pattern), truth_json));
   for (int k = 0; k < sets; ++k) {
     sim::SpraySet& s = rendered[static_cast<std::size_t>(k)];
     s.frames.trigger_timestamp_ns = static_cast<std::int64_t>(k) * 40'000'000;  // 25 Hz (Sect. 7.3)

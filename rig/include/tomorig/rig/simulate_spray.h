@@ -25,4 +25,12 @@ std::string write_spray_session(const sim::SprayOptions& options, int sets, cons
                                 storage::Compression compression, bool overwrite,
                                 const std::function<void(int done, int total)>& progress = {});
 
+// `--case spray-thesis --targets`: the knife-edge calibration series (Sect. 6.4). Set k holds
+// each camera's image (exposure A; B missing) of the slanted bar photomask at depth k of the
+// 13 PSF depths (-4.5 .. 4.5 mm, 0.75 mm apart). The truth: /truth/cameras; flow_name
+// "traverse"; flow_parameters = {"planes": [{"set", "z_mm"}], "cameras": [{"id", "z_mm",
+// "chi_um", ...}], "optics_setup_toml"} for `tomorig optics psf`.
+std::string write_spray_target_session(const sim::SprayOptions& options, const std::filesystem::path& out,
+                                       storage::Compression compression, bool overwrite);
+
 }  // namespace tomorig::rig
