@@ -4,6 +4,7 @@
 //   tomorig optics transmission --f-number 22 --magnification 0.9 --d 5,10,20,50 [--chi 40]
 //   tomorig optics psf --session targets.h5 [--z LIST] [--magnification LIST] [--json]
 #include <cmath>
+#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -197,8 +198,38 @@ void run_transmission(const OpticsArgs& a) {
 
 struct PsfArgs {
   std::string session, z, magnification;
-  bool json = false;
+  std::string setup_out, noise, liquid = "kerosene";
+  double f_number = 0;
+  bool json = false, overwrite = false;
 };
+
+double object_pixel_um(const storage::SessionReader& reader, const std::vector<double>& magnification, std::size_t c,
+                       double z_mm);
+
+// The measured chi as a set-up file for `tomorig optics visibility --setup` (docs/spray.md).
+std::string setup_toml(const PsfArgs& a, const storage::SessionReader& reader, const std::vector<double>& magnification,
+                       const std::vector<double>& z, const std::vector<std::vector<double>>& chi) {
+  const std::size_t cams = chi.size();
+  std::vector<double> noise;
+  for (const std::string& t : split(a.noise, ',')) noise.push_back(number(t, "--noise"));
+  if (noise.size() == 1) noise.assign(cams, noise[0]);
+  if (noise.size() != cams) throw bad_input(fmt::format("--noise: give one value, or one per camera ({})", cams));
+  std::string t = fmt::format("# PSF half-widths measured by `tomorig optics psf` on {}.\nliquid = \"{}\"\n", a.session,
+                              optics::Liquid::named(a.liquid).name);
+  for (std::size_t c = 0; c < cams; ++c) {
+    std::string zs, chis;
+    for (std::size_t k = 0; k < z.size(); ++k) {
+      if (!std::isfinite(chi[c][k])) continue;  // a depth without a measurable edge
+      zs += (zs.empty() ? "" : ", ") + fmt::format("{}", z[k]);
+      chis += (chis.empty() ? "" : ", ") + fmt::format("{:.2f}", chi[c][k]);
+    }
+    // The magnification at z = 0 (from the truth camera, or the one given).
+    const double m = reader.info().cameras[c].pixel_pitch_um / object_pixel_um(reader, magnification, c, 0.0);
+    t += fmt::format("\n[[cameras]]\nid = \"{}\"\nf_number = {}\nmagnification = {:.4f}\nnoise = {}\nz_mm = [{}]\nchi_um = [{}]\n",
+                     reader.info().cameras[c].id, a.f_number, m, noise[c], zs, chis);
+  }
+  return t;
+}
 
 // Object-space size (um) of one pixel of camera c at depth z: from the session's truth camera
 // (pinhole: depth along the axis / fx) when there is one, else pixel pitch / magnification.
@@ -212,6 +243,12 @@ double object_pixel_um(const storage::SessionReader& reader, const std::vector<d
 }
 
 void run_psf(const PsfArgs& a) {
+  if (!a.setup_out.empty()) {
+    storage::check_output_path(a.setup_out, a.overwrite, "set-up");
+    if (!(a.f_number > 0) || a.noise.empty())
+      throw bad_input("--setup-out needs --f-number and --noise (sigma of the flat-fielded bright field, one or one "
+                      "per camera) to describe the cameras");
+  }
   const storage::SessionReader reader(a.session);
   const std::size_t sets = reader.set_count(), cams = reader.info().cameras.size();
   if (sets == 0) throw bad_input(fmt::format("session '{}' has no sets: record one target image per depth", a.session));
@@ -251,6 +288,13 @@ void run_psf(const PsfArgs& a) {
         fmt::print(stderr, "set {} ({} mm), camera '{}': {}\n", k, z[k], reader.info().cameras[c].id, e.what());
       }
     }
+  }
+  if (!a.setup_out.empty()) {
+    const std::string text = setup_toml(a, reader, m, z, chi);
+    optics::parse_optics_setup(text, a.setup_out);  // what we write must read back
+    std::ofstream out(a.setup_out);
+    out << text;
+    if (!out) throw runtime_error(fmt::format("writing '{}' failed (is the disk full?)", a.setup_out));
   }
   if (a.json) {
     nlohmann::json out = nlohmann::json::array();
@@ -315,6 +359,12 @@ void add_optics_command(CLI::App& root) {
   p->add_option("--magnification", psf->magnification,
                 "magnification, one or one per camera (default: from the session's truth cameras)");
   p->add_flag("--json", psf->json, "print JSON instead of a table");
+  p->add_option("--setup-out", psf->setup_out, "also write the result as an optics set-up file (TOML) for "
+                                               "`optics visibility --setup`");
+  p->add_option("--f-number", psf->f_number, "--setup-out: the lenses' f-number");
+  p->add_option("--noise", psf->noise, "--setup-out: sigma of the flat-fielded bright field, one or one per camera");
+  p->add_option("--liquid", psf->liquid, "--setup-out: water or kerosene")->capture_default_str();
+  p->add_flag("--overwrite", psf->overwrite, "replace an existing --setup-out file");
   p->callback([psf] { run_psf(*psf); });
 }
 

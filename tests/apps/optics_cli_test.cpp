@@ -131,6 +131,28 @@ TEST_F(OpticsCli, PsfFromSimulatedTargetsMatchesTheTruthWithin5Percent) {
           << t["id"] << " at z = " << t["z_mm"][k];
     }
   }
+  // The measured chi feeds the visibility table: the set-up file it writes gives (nearly) the
+  // limits of the true set-up.
+  const std::string measured_setup = (dir_ / "measured.toml").string();
+  const CliResult out = run_tomorig("optics psf --session " + shell_quoted(session) + " --setup-out " +
+                                    shell_quoted(measured_setup) + " --f-number 22 --noise 0.010,0.006,0.006,0.010");
+  ASSERT_EQ(out.exit_code, 0) << out.err;
+  const std::string true_setup = (dir_ / "true.toml").string();
+  std::ofstream(true_setup) << truth["optics_setup_toml"].get<std::string>();
+  const CliResult a = run_tomorig("optics visibility --json --setup " + shell_quoted(measured_setup));
+  const CliResult b = run_tomorig("optics visibility --json --setup " + shell_quoted(true_setup));
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  const nlohmann::json ja = nlohmann::json::parse(a.out), jb = nlohmann::json::parse(b.out);
+  ASSERT_EQ(ja["rows"].size(), jb["rows"].size());
+  for (std::size_t k = 0; k < ja["rows"].size(); ++k)
+    EXPECT_NEAR(ja["rows"][k]["setup_d_min_um"].get<double>() / jb["rows"][k]["setup_d_min_um"].get<double>(), 1.0, 0.05)
+        << "z = " << ja["rows"][k]["z_mm"];
+  // Not replaced without --overwrite.
+  const CliResult again = run_tomorig("optics psf --session " + shell_quoted(session) + " --setup-out " +
+                                      shell_quoted(measured_setup) + " --f-number 22 --noise 0.01");
+  EXPECT_EQ(again.exit_code, 2);
+
   // A depth list that does not match the sets is refused with exit 2.
   const CliResult no_z = run_tomorig("optics psf --session " + shell_quoted(session) + " --z 1,2");
   EXPECT_EQ(no_z.exit_code, 2);
