@@ -1,5 +1,6 @@
-// The knife-edge PSF (thesis Sect. 6.4) against the spray-thesis simulator's PSF truth: every
-// camera, every one of the 13 calibration depths (0.75 mm apart), chi recovered within 5 %.
+// The knife-edge PSF (thesis Sect. 6.4) against the spray-thesis simulator's PSF truth: an outer
+// and an inner camera at every one of the 13 calibration depths (0.75 mm apart), chi recovered
+// within 5 % (all four cameras go through the CLI in tests/apps/optics_cli_test.cpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -30,7 +31,7 @@ TEST(EdgePsf, RecoversTheSimulatedHalfWidthAtEveryDepthWithin5Percent) {
   o.seed = 21;
   const sim::SprayCase c = sim::make_spray_thesis_case(o);
   double worst = 0;
-  for (std::size_t ci = 0; ci < c.cameras.size(); ++ci) {
+  for (std::size_t ci : {std::size_t{0}, std::size_t{2}}) {  // cam1 (-45 deg, f 105), cam3 (+25 deg, f 200)
     const sim::SprayCamera& cam = c.cameras[ci];
     for (std::size_t k = 0; k < cam.chi.size(); ++k) {
       const double z = cam.chi[k].z_mm;
@@ -45,7 +46,7 @@ TEST(EdgePsf, RecoversTheSimulatedHalfWidthAtEveryDepthWithin5Percent) {
       EXPECT_LT(std::abs(error), 0.05) << cam.id << " z " << z << ": " << chi_um << " um, truth " << cam.chi[k].chi_um;
     }
   }
-  std::printf("worst chi error over 4 cameras x 13 depths: %.2f %%\n", 100 * worst);
+  std::printf("worst chi error over 2 cameras x 13 depths: %.2f %%\n", 100 * worst);
 }
 
 TEST(EdgePsf, RefusesAnImageWithoutEdges) {
