@@ -13,6 +13,7 @@
 #include "commands.h"
 #include "tomorig/rig/simulate_calib_target.h"
 #include "tomorig/rig/simulate_session.h"
+#include "tomorig/rig/simulate_spray.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
 #include "tomorig/simulators/calibration_target.h"
@@ -39,7 +40,9 @@ struct SimulateFlags {
   std::string compression = "none";
   bool overwrite = false;
   bool reduced = false;
+  bool targets = false;
   double distortion_px = sim::CalibTargetOptions{}.distortion_corner_px;
+  std::string spray = sim::to_string(sim::SprayOptions{}.pattern);
   // Which optional flags were given: only those override the rig config.
   CLI::Option* case_opt = nullptr;
   CLI::Option* ppp_opt = nullptr;
@@ -47,6 +50,7 @@ struct SimulateFlags {
   CLI::Option* seed_opt = nullptr;
   CLI::Option* bit_depth_opt = nullptr;
   CLI::Option* distortion_opt = nullptr;
+  CLI::Option* spray_opt = nullptr;
 };
 
 // calib-thesis is a target case, not a particle case: it has its own renderer and writes one
@@ -63,14 +67,38 @@ void run_calib_thesis(const SimulateFlags& f, storage::Compression compression) 
   fmt::print("{}\n", write_calib_target_session(o, f.out, compression, f.overwrite));
 }
 
+// spray-thesis is a shadowgraphy case with its own renderer (spray.h, simulate_spray.h):
+// droplets, LED bright field and the visibility truth. Noise is always on.
+void run_spray_thesis(const SimulateFlags& f, storage::Compression compression) {
+  if (f.ppp_opt->count() || f.bit_depth_opt->count() || f.distortion_opt->count() || !f.config.empty())
+    throw bad_input("--case spray-thesis takes no --ppp, --bit-depth, --distortion-px or --config: it renders a droplet "
+                    "field (--spray hollow-cone or jet-in-crossflow) on 16-bit cameras");
+  sim::SprayOptions o;
+  o.reduced = f.reduced;
+  if (f.seed_opt->count()) o.seed = f.seed;
+  o.pattern = sim::parse_spray_pattern(f.spray);
+  if (f.targets) {
+    if (f.sets_opt->count()) throw bad_input("--targets renders one set per PSF depth (13): --sets does not apply");
+    fmt::print("{}\n", rig::write_spray_target_session(o, f.out, compression, f.overwrite));
+    return;
+  }
+  const int sets = f.sets_opt->count() ? f.sets : 2;
+  fmt::print("{}\n", rig::write_spray_session(o, sets, f.out, compression, f.overwrite, [](int done, int total) {
+               fmt::print(stderr, "set {}/{} rendered\n", done, total);
+               std::fflush(stderr);
+             }));
+}
+
 void run_simulate(const SimulateFlags& f) {
   const auto compression = storage::parse_compression(f.compression);
   if (!compression)
     throw bad_input(fmt::format("--compression '{}' is unknown: use none or bitshuffle-lz4", f.compression));
 
   if (f.case_opt->count() && f.case_name == "calib-thesis") return run_calib_thesis(f, *compression);
+  if (f.case_opt->count() && f.case_name == "spray-thesis") return run_spray_thesis(f, *compression);
+  if (f.spray_opt->count() || f.targets) throw bad_input("--spray and --targets apply to --case spray-thesis only");
   if (f.reduced || f.distortion_opt->count())
-    throw bad_input("--reduced and --distortion-px apply to --case calib-thesis only");
+    throw bad_input("--reduced applies to --case spray-thesis or calib-thesis only, --distortion-px to calib-thesis only");
 
   config::RigConfig rig = f.config.empty() ? config::default_rig_config() : config::load_rig_config(f.config);
   if (!rig.simulation) rig.simulation.emplace();
@@ -136,7 +164,7 @@ void add_simulate_command(CLI::App& root) {
   CLI::App* cmd = root.add_subcommand(
       "simulate", "Render a built-in synthetic case into a session file (HDF5) with its ground truth");
   flags->case_opt =
-      cmd->add_option("--case", flags->case_name, "simulation case: " + sim::case_names() + ", calib-thesis");
+      cmd->add_option("--case", flags->case_name, "simulation case: " + sim::case_names() + ", calib-thesis, spray-thesis");
   flags->ppp_opt = cmd->add_option("--ppp", flags->ppp, "particle images per pixel, in (0, 1]");
   flags->sets_opt = cmd->add_option("--sets", flags->sets, "number of double-frame sets to render");
   flags->seed_opt = cmd->add_option("--seed", flags->seed, "random seed (recorded in the truth)");
@@ -147,7 +175,11 @@ void add_simulate_command(CLI::App& root) {
   cmd->add_option("--compression", flags->compression, "frame compression: none or bitshuffle-lz4")
       ->capture_default_str();
   cmd->add_flag("--overwrite", flags->overwrite, "replace an existing output file");
-  cmd->add_flag("--reduced", flags->reduced, "calib-thesis: the reduced 640 x 540 variant (for tests)");
+  cmd->add_flag("--reduced", flags->reduced, "calib-thesis, spray-thesis: the reduced 640 x 540 variant (for tests)");
+  flags->spray_opt = cmd->add_option("--spray", flags->spray, "spray-thesis: hollow-cone or jet-in-crossflow")
+                         ->capture_default_str();
+  cmd->add_flag("--targets", flags->targets,
+                "spray-thesis: the knife-edge calibration series (one set per PSF depth) instead of droplets");
   flags->distortion_opt = cmd->add_option("--distortion-px", flags->distortion_px,
                                           "calib-thesis: radial lens distortion at the image corner, full-size px");
   cmd->callback([flags] { run_simulate(*flags); });

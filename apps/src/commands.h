@@ -24,5 +24,6 @@ void add_process_command(CLI::App& root);  // cmd_process.cpp: the back-end pipe
 void add_piv3d_command(CLI::App& root);    // cmd_piv3d.cpp: correlate two volumes
 void add_stages_command(CLI::App& root);   // cmd_stages.cpp: list stages, run a chain over a session
 void add_preview_command(CLI::App& root);  // cmd_preview.cpp: watch the quick-look of a run
+void add_optics_command(CLI::App& root);   // cmd_optics.cpp: droplet imaging model, visibility
 
 }  // namespace tomorig::app

@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   add_piv3d_command(app);
   add_stages_command(app);
   add_preview_command(app);
+  add_optics_command(app);
   tomorig::bench::add_bench_command(app);
   add_trigger_command(app);
 

@@ -1,0 +1,219 @@
+// The spray-thesis case as a session file, truth alongside.
+#include "tomorig/rig/simulate_spray.h"
+
+#include <chrono>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "tomorig/core/error.h"
+#include "tomorig/core/version.h"
+#include "tomorig/storage/output_path.h"
+
+namespace tomorig::rig {
+
+std::string spray_optics_setup_toml(const sim::SprayCase& c) {
+  std::string t = fmt::format(
+      "# The optics of `tomorig simulate --case spray-thesis` (seed {}): chi_um is the true PSF half-width.\n"
+      "liquid = \"{}\"\nd_max_um = {}\n\n[led]\npeak_nm = {}\nfwhm_nm = {}\nsamples = {}\n",
+      c.options.seed, c.optics.liquid.name, c.optics.d_max_um, c.optics.spectrum.peak_nm, c.optics.spectrum.fwhm_nm,
+      c.optics.spectrum.samples);
+  for (const sim::SprayCamera& cam : c.cameras) {
+    std::string z, chi;
+    for (const optics::ChiSample& s : cam.chi) {
+      z += (z.empty() ? "" : ", ") + fmt::format("{}", s.z_mm);
+      chi += (chi.empty() ? "" : ", ") + fmt::format("{:.3f}", s.chi_um);
+    }
+    t += fmt::format("\n[[cameras]]\nid = \"{}\"\nf_number = {}\nmagnification = {}\nnoise = {}\nz_mm = [{}]\nchi_um = [{}]\n",
+                     cam.id, cam.f_number, cam.magnification, cam.noise_sigma, z, chi);
+  }
+  return t;
+}
+
+namespace {
+
+nlohmann::json cameras_json(const sim::SprayCase& c) {
+  nlohmann::json cams = nlohmann::json::array();
+  for (const sim::SprayCamera& cam : c.cameras) {
+    nlohmann::json z = nlohmann::json::array(), chi = nlohmann::json::array();
+    for (const optics::ChiSample& s : cam.chi) {
+      z.push_back(s.z_mm);
+      chi.push_back(s.chi_um);
+    }
+    cams.push_back({{"id", cam.id},
+                    {"yaw_deg", cam.yaw_deg},
+                    {"magnification", cam.magnification},
+                    {"f_number", cam.f_number},
+                    {"pixel_pitch_um", cam.pixel_pitch_um},
+                    {"noise", cam.noise_sigma},
+                    {"threshold", cam.threshold_value()},
+                    {"z_mm", z},
+                    {"chi_um", chi}});
+  }
+  return cams;
+}
+
+storage::SessionTruth truth_of(const sim::SprayCase& c, const std::string& flow_name, const nlohmann::json& parameters) {
+  storage::SessionTruth truth;
+  truth.case_name = c.name;
+  truth.flow_name = flow_name;
+  truth.flow_parameters = parameters.dump();
+  truth.seed = c.options.seed;
+  for (const sim::SprayCamera& cam : c.cameras) {
+    const auto& p = cam.pinhole.parameters();
+    storage::TruthCamera t;
+    t.id = cam.id;
+    t.K = cam.pinhole.intrinsics();
+    t.R = p.R;
+    t.t = p.t;
+    t.width = cam.width;
+    t.height = cam.height;
+    truth.cameras.push_back(t);
+  }
+  return truth;
+}
+
+storage::SessionInfo info_of(const sim::SprayCase& c, storage::Compression compression, const std::string& comment) {
+  storage::SessionInfo info;
+  for (const sim::SprayCamera& cam : c.cameras)
+    info.cameras.push_back({cam.id, cam.width, cam.height, PixelFormat::Mono16, cam.pixel_pitch_um});
+  info.rig_config_toml = comment;
+  info.software_version = std::string(software_version());
+  info.compression = compression;
+  return info;
+}
+
+}  // namespace
+
+std::string write_spray_target_session(const sim::SprayOptions& options, const std::filesystem::path& out,
+                                       storage::Compression compression, bool overwrite) {
+  storage::check_output_path(out, overwrite, "session");
+  const auto start = std::chrono::steady_clock::now();
+  const sim::SprayCase c = sim::make_spray_thesis_case(options);
+  const std::vector<optics::ChiSample>& depths = c.cameras.front().chi;
+  nlohmann::json planes = nlohmann::json::array();
+  for (std::size_t k = 0; k < depths.size(); ++k) planes.push_back({{"set", k}, {"z_mm", depths[k].z_mm}});
+  const nlohmann::json parameters = {{"target", "bars: 1 mm clear, 1 mm chromium (5 %), slanted 4 deg from y"},
+                                     {"planes", planes},
+                                     {"reduced", c.options.reduced},
+                                     {"cameras", cameras_json(c)},
+                                     {"optics_setup_toml", spray_optics_setup_toml(c)}};
+  storage::SessionWriterOptions wo;
+  wo.compression = compression;
+  wo.overwrite = overwrite;
+  storage::SessionWriter writer(
+      out,
+      info_of(c, compression,
+              "# Written by `tomorig simulate --case spray-thesis --targets`: set k shows a slanted bar photomask at\n"
+              "# depth k (planes[k].z_mm in /truth flow_parameters), for `tomorig optics psf`. No rig config applies.\n"),
+      wo);
+  writer.write_truth(truth_of(c, "traverse", parameters));
+  for (std::size_t k = 0; k < depths.size(); ++k) {
+    FrameSet set;
+    set.set_index = k;
+    set.trigger_index = k;
+    for (std::size_t ci = 0; ci < c.cameras.size(); ++ci) {
+      CameraFrames frames;
+      frames.camera_id = c.cameras[ci].id;
+      frames.a.image = sim::render_spray_edge_target(c, ci, depths[k].z_mm, k);
+      set.cameras.push_back(std::move(frames));
+    }
+    writer.append(set);
+    writer.write_truth_set(k, {});
+  }
+  writer.finish();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return fmt::format("wrote {}: spray-thesis targets{}, {} depths x {} cameras, {} x {} px, seed {}, {:.1f} s", out.string(),
+                     c.options.reduced ? " (reduced)" : "", depths.size(), c.cameras.size(), c.cameras[0].width,
+                     c.cameras[0].height, c.options.seed, seconds);
+}
+
+std::string write_spray_session(const sim::SprayOptions& options, int sets, const std::filesystem::path& out,
+                                storage::Compression compression, bool overwrite,
+                                const std::function<void(int, int)>& progress) {
+  if (sets < 1) throw bad_input(fmt::format("--sets {} is invalid: it must be >= 1", sets));
+  storage::check_output_path(out, overwrite, "session");
+  const auto start = std::chrono::steady_clock::now();
+  const sim::SprayCase c = sim::make_spray_thesis_case(options);
+
+  // The truth JSON holds every droplet, so the sets are rendered before the file is written.
+  std::vector<sim::SpraySet> rendered;
+  nlohmann::json set_truth = nlohmann::json::array();
+  for (int k = 0; k < sets; ++k) {
+    sim::SpraySet s = sim::render_spray_set(c, static_cast<std::uint64_t>(k));
+    nlohmann::json d = nlohmann::json::array(), visible = nlohmann::json::array(), imin = nlohmann::json::array();
+    for (const sim::Droplet& drop : s.droplets) {
+      d.push_back(std::round(drop.d_um * 1000.0) / 1000.0);
+      int mask = 0;
+      nlohmann::json m = nlohmann::json::array();
+      for (std::size_t ci = 0; ci < drop.visible.size(); ++ci) {
+        if (drop.visible[ci]) mask |= 1 << ci;
+        m.push_back(std::round(drop.min_intensity[ci] * 1e5) / 1e5);
+      }
+      visible.push_back(mask);
+      imin.push_back(m);
+    }
+    set_truth.push_back({{"set", k},
+                         {"d_um", d},
+                         {"visible_mask", visible},
+                         {"min_intensity", imin},
+                         {"pulse_energy_a", s.pulse_energy_a},
+                         {"pulse_energy_b", s.pulse_energy_b}});
+    rendered.push_back(std::move(s));
+    if (progress) progress(k + 1, sets);
+  }
+  const nlohmann::json truth_json = {
+      {"pattern", sim::to_string(c.options.pattern)},
+      {"reduced", c.options.reduced},
+      {"droplets_per_set", c.options.droplets},
+      {"d_median_um", c.options.d_median_um},
+      {"d_log_sigma", c.options.d_log_sigma},
+      {"d_range_um", {c.options.d_min_um, c.options.d_max_um}},
+      {"dt_us", c.options.dt_us},
+      {"bright_fraction", c.options.bright_fraction},
+      {"vignetting", c.options.vignetting},
+      {"pulse_jitter", c.options.pulse_jitter},
+      {"liquid", c.optics.liquid.name},
+      {"led", {{"peak_nm", c.optics.spectrum.peak_nm}, {"fwhm_nm", c.optics.spectrum.fwhm_nm}}},
+      {"volume_mm", {{c.volume_min.x, c.volume_min.y, c.volume_min.z}, {c.volume_max.x, c.volume_max.y, c.volume_max.z}}},
+      {"cameras", cameras_json(c)},
+      {"visible", "visible_mask bit c: the droplet's own shadow at pulse A reaches camera c's threshold 1 - 2 noise"},
+      {"optics_setup_toml", spray_optics_setup_toml(c)},
+      {"sets", set_truth}};
+
+  storage::SessionWriterOptions wo;
+  wo.compression = compression;
+  wo.overwrite = overwrite;
+  storage::SessionWriter writer(
+      out,
+      info_of(c, compression,
+              fmt::format("# Written by `tomorig simulate --case spray-thesis`{}: {} droplets per set, pattern {}; the "
+                          "truth\n# (flow_parameters) holds the optics set-up and every droplet. No rig config applies.\n",
+                          c.options.reduced ? " --reduced" : "", c.options.droplets, sim::to_string(c.options.pattern))),
+      wo);
+  writer.write_truth(truth_of(c, sim::to_string(c.options.pattern), truth_json));
+  for (int k = 0; k < sets; ++k) {
+    sim::SpraySet& s = rendered[static_cast<std::size_t>(k)];
+    s.frames.trigger_timestamp_ns = static_cast<std::int64_t>(k) * 40'000'000;  // 25 Hz (Sect. 7.3)
+    for (CameraFrames& cf : s.frames.cameras) {
+      cf.a.timestamp_ns += s.frames.trigger_timestamp_ns;
+      cf.b.timestamp_ns += s.frames.trigger_timestamp_ns;
+    }
+    writer.append(s.frames);
+    storage::TruthSet ts;
+    for (const sim::Droplet& d : s.droplets) {
+      ts.particles_a.push_back(d.a);
+      ts.particles_b.push_back(d.b);
+    }
+    writer.write_truth_set(static_cast<std::uint64_t>(k), ts);
+  }
+  writer.finish();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return fmt::format("wrote {}: spray-thesis{} ({}), {} sets x {} cameras, {} x {} px, {} droplets per set, seed {}, "
+                     "{:.1f} s",
+                     out.string(), c.options.reduced ? " (reduced)" : "", sim::to_string(c.options.pattern), sets,
+                     c.cameras.size(), c.cameras[0].width, c.cameras[0].height, c.options.droplets, c.options.seed,
+                     seconds);
+}
+
+}  // namespace tomorig::rig
