@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <map>
 
 #include <fmt/core.h>
@@ -104,6 +105,7 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
   VectorField field;
   for (std::size_t p = 0; p < options.passes.size(); ++p) {
     const auto start_pass = std::chrono::steady_clock::now();
+    PassReport pr;
     const CorrelationPass& pass = options.passes[p];
     Level& level = level_for(pass.downsample);
     const PassGeometry g = geometry_of(pass, level.view_a);
@@ -125,6 +127,8 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
       va.data = level.deformed_a.data();
       vb.data = level.deformed_b.data();
     }
+    pr.seconds_deformation = seconds_since(start_pass);
+    const auto start_windows = std::chrono::steady_clock::now();
 
     field = VectorField(g.nodes.x, g.nodes.y, g.nodes.z);
     field.origin = {g.centre(0, g.step.x, g.window.x), g.centre(0, g.step.y, g.window.y), g.centre(0, g.step.z, g.window.z)};
@@ -132,8 +136,9 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
 
     const detail::FftCorrelator correlator(g.window, options.weighting, options.gaussian_sigma);
     const long long node_count = static_cast<long long>(field.count());
-    std::size_t fallbacks = 0;
-#pragma omp parallel num_threads(threads) reduction(+ : fallbacks)
+    std::size_t fallbacks = 0, empty = 0;
+    double load = 0, correlation = 0, peak_fit = 0;
+#pragma omp parallel num_threads(threads) reduction(+ : fallbacks, empty, load, correlation, peak_fit)
     {
       auto scratch = correlator.make_scratch();  // once per thread and pass, never per window
 #pragma omp for schedule(dynamic, 4)
@@ -157,13 +162,23 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
         const Int3 start_b{start_a.x + offset.x, start_a.y + offset.y, start_a.z + offset.z};
         const detail::WindowPeak peak = correlator.correlate(va, start_a, vb, start_b, scratch);
         fallbacks += peak.fallbacks;
+        empty += peak.empty;
         if (!peak.valid) continue;  // stays invalid with peak 0
         const Vec3f base = deform ? predicted : Vec3f{float(offset.x), float(offset.y), float(offset.z)};
         field.displacement[n] = {(base.x + peak.dx) * g.factor, (base.y + peak.dy) * g.factor, (base.z + peak.dz) * g.factor};
         field.peak[n] = peak.peak;
         field.status[n] = VectorStatus::valid;
       }
+      load += scratch.seconds.load;
+      correlation += scratch.seconds.correlation;
+      peak_fit += scratch.seconds.peak;
     }
+    pr.seconds_windows = seconds_since(start_windows);
+    pr.thread_seconds_load = load;
+    pr.thread_seconds_correlation = correlation;
+    pr.thread_seconds_peak = peak_fit;
+    pr.empty_windows = empty;
+    const auto start_validation = std::chrono::steady_clock::now();
 
     std::vector<std::uint8_t> mask;
     if (options.illumination) {
@@ -178,7 +193,6 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
     }
     const ValidationCounts counts = validate_field(field, options, mask);
 
-    PassReport pr;
     pr.nodes_x = field.nx;
     pr.nodes_y = field.ny;
     pr.nodes_z = field.nz;
@@ -195,6 +209,7 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
       if (options.smooth_predictor) detail::smooth_gaussian3(predictor);
       have_predictor = true;
     }
+    pr.seconds_validation = seconds_since(start_validation);
     pr.seconds = seconds_since(start_pass);
     report.passes.push_back(pr);
   }
@@ -219,6 +234,38 @@ VectorField correlate(const SparseVolume& a, const SparseVolume& b, const Correl
                                 a.grid.nx, a.grid.ny, a.grid.nz, b.grid.nx, b.grid.ny, b.grid.nz));
   options.validate(a.grid);
   return correlate(a.to_dense(), b.to_dense(), options, report);
+}
+
+FftFloor measure_fft_floor(const VoxelGrid& grid, const CorrelationOptions& options) {
+  options.validate(grid);
+  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  FftFloor floor;
+  for (const CorrelationPass& pass : options.passes) {
+    const int f = pass.downsample;
+    const VolumeView level{nullptr, grid.nx / f, grid.ny / f, grid.nz / f};
+    const PassGeometry g = geometry_of(pass, level);
+    const long long windows = static_cast<long long>(g.nodes.x) * g.nodes.y * g.nodes.z;
+    const detail::FftCorrelator correlator(g.window, WindowWeighting::top_hat);
+    const auto start = std::chrono::steady_clock::now();
+#pragma omp parallel num_threads(threads)
+    {
+      auto scratch = correlator.make_scratch();
+      // Particle-like data (not zeros: FFTW's speed does not depend on the values, but
+      // subnormals would), the same in every thread.
+      const std::size_t count = static_cast<std::size_t>(g.window.x) * g.window.y * g.window.z;
+      std::uint32_t state = 12345u;
+      for (std::size_t m = 0; m < count; ++m) {
+        state = state * 1664525u + 1013904223u;
+        scratch.a.get()[m] = static_cast<float>(state >> 8) * (1.0f / 16777216.0f);
+        scratch.b.get()[m] = scratch.a.get()[(m + 7) % count];
+      }
+#pragma omp for schedule(dynamic, 4)
+      for (long long n = 0; n < windows; ++n) correlator.transforms_only(scratch);
+    }
+    floor.pass_seconds.push_back(seconds_since(start));
+    floor.seconds_total += floor.pass_seconds.back();
+  }
+  return floor;
 }
 
 }  // namespace tomorig::piv
