@@ -96,6 +96,7 @@ nlohmann::json to_json(const piv::CorrelationReport& r) {
                       {"peak_fallbacks", p.peak_fallbacks},
                       {"empty_windows", p.empty_windows},
                       {"method", p.method},
+                      {"fft_fallbacks", p.fft_fallbacks},
                       {"seconds", p.seconds},
                       {"seconds_deformation", p.seconds_deformation},
                       {"seconds_windows", p.seconds_windows},

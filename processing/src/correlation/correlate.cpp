@@ -6,9 +6,11 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <optional>
 
 #include <fmt/core.h>
 
+#include "correlation/direct_correlator.h"
 #include "correlation/fft_correlator.h"
 #include "correlation/predictor_filters.h"
 #include "correlation/volume_deformation.h"
@@ -48,6 +50,18 @@ PassGeometry geometry_of(const CorrelationPass& pass, const VolumeView& level) {
   g.nodes = {(level.nx - g.window.x) / g.step.x + 1, (level.ny - g.window.y) / g.step.y + 1,
              (level.nz - g.window.z) / g.step.z + 1};
   return g;
+}
+
+// Above this mean fraction of occupied voxels in the deformed pair, the direct correlation's
+// gathers cost more than the FFTs of a window (estimated from the operation counts: 3 x 27
+// products per occupied voxel against three N log N transforms, with a margin for the
+// gathers); a deterministic choice, so every process picks the same method.
+constexpr double kDirectMaxOccupancy = 0.08;
+
+bool use_direct(const CorrelationPass& pass, Int3 window, bool deform, double occupancy) {
+  if (!deform || pass.method == CorrelationMethod::fft) return false;
+  if (window.x < 8 || window.y < 8 || window.z < 8) return false;  // lags +-2 must not reach the wrap
+  return pass.method == CorrelationMethod::direct || occupancy <= kDirectMaxOccupancy;
 }
 
 bool same_grid(const VoxelGrid& a, const VoxelGrid& b) {
@@ -135,12 +149,25 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
     field.spacing = {double(g.factor * g.step.x), double(g.factor * g.step.y), double(g.factor * g.step.z)};
 
     const detail::FftCorrelator correlator(g.window, options.weighting, options.gaussian_sigma);
+    // Sparse direct correlation of the deformation passes: the occupied voxels listed once, in
+    // blocks of the window step that the overlapping windows share.
+    detail::OccupiedVoxels occupied_a, occupied_b;
+    bool direct = false;
+    if (deform && pass.method != CorrelationMethod::fft && g.window.x >= 8 && g.window.y >= 8 && g.window.z >= 8) {
+      occupied_a = detail::list_occupied(va, g.step, detail::kOccupiedThreshold, threads);
+      occupied_b = detail::list_occupied(vb, g.step, detail::kOccupiedThreshold, threads);
+      direct = use_direct(pass, g.window, deform, 0.5 * (occupied_a.occupied_fraction + occupied_b.occupied_fraction));
+    }
+    std::optional<detail::DirectCorrelator> direct_correlator;
+    if (direct) direct_correlator.emplace(g.window, options.weighting, options.gaussian_sigma);
+    pr.method = direct ? "direct" : "fft";
     const long long node_count = static_cast<long long>(field.count());
-    std::size_t fallbacks = 0, empty = 0;
+    std::size_t fallbacks = 0, empty = 0, fft_fallbacks = 0;
     double load = 0, correlation = 0, peak_fit = 0;
-#pragma omp parallel num_threads(threads) reduction(+ : fallbacks, empty, load, correlation, peak_fit)
+#pragma omp parallel num_threads(threads) reduction(+ : fallbacks, empty, fft_fallbacks, load, correlation, peak_fit)
     {
       auto scratch = correlator.make_scratch();  // once per thread and pass, never per window
+      detail::DirectCorrelator::Scratch direct_scratch;
 #pragma omp for schedule(dynamic, 4)
       for (long long n = 0; n < node_count; ++n) {
         const int i = static_cast<int>(n % g.nodes.x);
@@ -160,7 +187,13 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
                     static_cast<int>(std::lround(predicted.z))};
         const Int3 start_a{start.x - floor_half(offset.x), start.y - floor_half(offset.y), start.z - floor_half(offset.z)};
         const Int3 start_b{start_a.x + offset.x, start_a.y + offset.y, start_a.z + offset.z};
-        const detail::WindowPeak peak = correlator.correlate(va, start_a, vb, start_b, scratch);
+        detail::WindowPeak peak;
+        bool by_fft = !direct;
+        if (direct) {
+          peak = direct_correlator->correlate(occupied_a, vb, occupied_b, start, direct_scratch, by_fft);
+          fft_fallbacks += by_fft;
+        }
+        if (by_fft) peak = correlator.correlate(va, start_a, vb, start_b, scratch);
         fallbacks += peak.fallbacks;
         empty += peak.empty;
         if (!peak.valid) continue;  // stays invalid with peak 0
@@ -169,10 +202,11 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
         field.peak[n] = peak.peak;
         field.status[n] = VectorStatus::valid;
       }
-      load += scratch.seconds.load;
-      correlation += scratch.seconds.correlation;
-      peak_fit += scratch.seconds.peak;
+      load += scratch.seconds.load + direct_scratch.seconds.load;
+      correlation += scratch.seconds.correlation + direct_scratch.seconds.correlation;
+      peak_fit += scratch.seconds.peak + direct_scratch.seconds.peak;
     }
+    pr.fft_fallbacks = fft_fallbacks;
     pr.seconds_windows = seconds_since(start_windows);
     pr.thread_seconds_load = load;
     pr.thread_seconds_correlation = correlation;

@@ -53,6 +53,15 @@ const PlanPair& plans_for(Int3 w) {
   return it->second;
 }
 
+int signed_lag(int index, int size) { return index < size / 2 ? index : index - size; }
+
+using Clock = std::chrono::steady_clock;
+double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+
+}  // namespace
+
+void FftwFree::operator()(void* p) const { fftwf_free(p); }
+
 std::vector<float> axis_weights(int n, WindowWeighting weighting, double gaussian_sigma) {
   std::vector<float> w(n, 1.0f);
   const double centre = 0.5 * (n - 1);
@@ -66,14 +75,6 @@ std::vector<float> axis_weights(int n, WindowWeighting weighting, double gaussia
   return w;
 }
 
-int signed_lag(int index, int size) { return index < size / 2 ? index : index - size; }
-
-using Clock = std::chrono::steady_clock;
-double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
-
-}  // namespace
-
-void FftwFree::operator()(void* p) const { fftwf_free(p); }
 
 FftCorrelator::FftCorrelator(Int3 window, WindowWeighting weighting, double gaussian_sigma)
     : window_(window),

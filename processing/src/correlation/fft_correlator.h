@@ -28,6 +28,9 @@ struct StageSeconds {
   double load = 0, correlation = 0, peak = 0;
 };
 
+// The weights of one axis of a window (the window's weights are the product of the three).
+std::vector<float> axis_weights(int n, WindowWeighting weighting, double gaussian_sigma);
+
 class FftCorrelator {
  public:
   // gaussian_sigma: the Gaussian weighting's standard deviation as a fraction of the window

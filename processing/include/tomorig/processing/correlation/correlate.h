@@ -21,6 +21,7 @@ struct PassReport {
   std::size_t peak_fallbacks = 0;    // axes fitted by the fallback instead of the 3-point Gaussian
   std::size_t empty_windows = 0;     // windows without contrast, skipped before any correlation
   const char* method = "fft";        // how the windows were correlated: "fft" or "direct"
+  std::size_t fft_fallbacks = 0;     // direct pass: windows whose peak lay beyond lag +-1, done by FFT
   // Time breakdown (wall seconds of the pass's stages, on the calling thread):
   double seconds = 0.0;              // the whole pass
   double seconds_deformation = 0.0;  // binning, B-spline prefilter and volume deformation
