@@ -29,6 +29,8 @@ struct Level {
   VolumeView view_a, view_b;
   std::vector<float> coef_a, coef_b;    // cubic B-spline coefficients, empty until needed
   std::vector<float> deformed_a, deformed_b;
+  std::vector<std::uint8_t> support_a, support_b;  // signal_support of a and b, empty until needed
+  detail::OccupiedVoxels occupied_a, occupied_b;   // of the deformed pair, memory reused by each pass
 };
 
 // Where the windows of a pass sit, in voxels of its (binned) level.
@@ -137,7 +139,13 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
         va.data = level.coef_a.data();
         vb.data = level.coef_b.data();
       }
-      detail::deform_pair(va, vb, predictor, g.factor, pass.interpolation, level.deformed_a, level.deformed_b, threads);
+      // Where the samples have signal: made once per level, reused by every deformation pass.
+      if (level.support_a.empty()) {
+        level.support_a = detail::signal_support(level.view_a, detail::kOccupiedThreshold, detail::kSupportRadius, threads);
+        level.support_b = detail::signal_support(level.view_b, detail::kOccupiedThreshold, detail::kSupportRadius, threads);
+      }
+      detail::deform_pair(va, vb, predictor, g.factor, pass.interpolation, level.deformed_a, level.deformed_b, threads,
+                          level.support_a, level.support_b);
       va.data = level.deformed_a.data();
       vb.data = level.deformed_b.data();
     }
@@ -151,11 +159,12 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
     const detail::FftCorrelator correlator(g.window, options.weighting, options.gaussian_sigma);
     // Sparse direct correlation of the deformation passes: the occupied voxels listed once, in
     // blocks of the window step that the overlapping windows share.
-    detail::OccupiedVoxels occupied_a, occupied_b;
+    const detail::OccupiedVoxels& occupied_a = level.occupied_a;
+    const detail::OccupiedVoxels& occupied_b = level.occupied_b;
     bool direct = false;
     if (deform && pass.method != CorrelationMethod::fft && g.window.x >= 8 && g.window.y >= 8 && g.window.z >= 8) {
-      occupied_a = detail::list_occupied(va, g.step, detail::kOccupiedThreshold, threads);
-      occupied_b = detail::list_occupied(vb, g.step, detail::kOccupiedThreshold, threads);
+      detail::list_occupied(va, g.step, detail::kOccupiedThreshold, threads, level.occupied_a);
+      detail::list_occupied(vb, g.step, detail::kOccupiedThreshold, threads, level.occupied_b);
       direct = use_direct(pass, g.window, deform, 0.5 * (occupied_a.occupied_fraction + occupied_b.occupied_fraction));
     }
     std::optional<detail::DirectCorrelator> direct_correlator;

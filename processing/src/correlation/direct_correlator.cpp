@@ -37,8 +37,7 @@ inline int lag_index(int dx, int dy, int dz) { return (dx + 1) + 3 * ((dy + 1) +
 
 }  // namespace
 
-OccupiedVoxels list_occupied(const VolumeView& v, Int3 block, float relative_threshold, int threads) {
-  OccupiedVoxels o;
+void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, int threads, OccupiedVoxels& o) {
   o.block = block;
   o.blocks = {ceil_div(v.nx, block.x), ceil_div(v.ny, block.y), ceil_div(v.nz, block.z)};
   const std::size_t block_count = static_cast<std::size_t>(o.blocks.x) * o.blocks.y * o.blocks.z;
@@ -47,7 +46,8 @@ OccupiedVoxels list_occupied(const VolumeView& v, Int3 block, float relative_thr
 #pragma omp parallel for num_threads(threads) reduction(max : largest) schedule(static)
   for (long long n = 0; n < static_cast<long long>(voxels); ++n) largest = std::max(largest, std::abs(v.data[n]));
   const float threshold = relative_threshold * largest;
-  std::vector<std::size_t> counts(block_count + 1, 0);
+  std::vector<std::size_t>& counts = o.offsets;  // counts, then their running sum, then fill cursors
+  counts.assign(block_count + 1, 0);
   auto block_of = [&](int x, int y, int z) {
     return static_cast<std::size_t>(x / block.x) +
            static_cast<std::size_t>(o.blocks.x) * (y / block.y + static_cast<std::size_t>(o.blocks.y) * (z / block.z));
@@ -63,7 +63,6 @@ OccupiedVoxels list_occupied(const VolumeView& v, Int3 block, float relative_thr
           if (std::abs(row[x]) > threshold) ++counts[block_of(x, y, z) + 1];
       }
   for (std::size_t b = 0; b < block_count; ++b) counts[b + 1] += counts[b];
-  o.offsets = counts;
   o.entries.resize(counts[block_count]);
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
   for (int bz = 0; bz < o.blocks.z; ++bz)
@@ -75,8 +74,10 @@ OccupiedVoxels list_occupied(const VolumeView& v, Int3 block, float relative_thr
             o.entries[counts[block_of(x, y, z)]++] = {static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y),
                                                       static_cast<std::uint16_t>(z), row[x]};
       }
+  // The fill advanced each block's start to the next block's: shift back by one block.
+  for (std::size_t b = block_count; b > 0; --b) counts[b] = counts[b - 1];
+  counts[0] = 0;
   o.occupied_fraction = voxels ? static_cast<double>(o.entries.size()) / static_cast<double>(voxels) : 0.0;
-  return o;
 }
 
 DirectCorrelator::DirectCorrelator(Int3 window, WindowWeighting weighting, double gaussian_sigma)

@@ -28,7 +28,8 @@ struct OccupiedVoxels {
   std::vector<Entry> entries;
   double occupied_fraction = 0;       // entries / voxels
 };
-OccupiedVoxels list_occupied(const VolumeView& v, Int3 block, float relative_threshold, int threads);
+// Fills `out`, reusing its memory (one list per volume for a whole correlation).
+void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, int threads, OccupiedVoxels& out);
 
 // The fraction of a volume's largest magnitude below which a voxel counts as empty.
 inline constexpr float kOccupiedThreshold = 1e-3f;
