@@ -179,7 +179,8 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
     if (x < 0 || y < 0 || z < 0 || x >= vb.nx || y >= vb.ny || z >= vb.nz) return 0.0f;
     return vb.data[vb.linear(x, y, z)];
   };
-  double p[27] = {}, qa[27] = {};
+  double p[27] = {}, qa[27] = {};            // the edge entries, and the sums at the end
+  alignas(16) float p4[9][4] = {}, qa4[9][4] = {};  // the interior entries: per (dy, dz) row, 4 x lanes
   const std::size_t count = s.a_weight.size();
   const std::size_t sy = static_cast<std::size_t>(vb.nx), sz = sy * static_cast<std::size_t>(vb.ny);
   const bool inside = start.x >= 0 && start.y >= 0 && start.z >= 0 && start.x + w.x <= vb.nx &&
@@ -193,22 +194,24 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
       py[d + 1] = wy_[wrap(j + d, w.y)];
       pz[d + 1] = wz_[wrap(k + d, w.z)];
     }
-    const bool interior = inside && i >= 1 && j >= 1 && k >= 1 && i + 1 < w.x && j + 1 < w.y && k + 1 < w.z;
+    // Interior: no wrap, no bounds, and the row's fourth value (weight 0) is inside the volume.
+    const bool interior = inside && i >= 1 && j >= 1 && k >= 1 && i + 2 < w.x && j + 1 < w.y && k + 1 < w.z;
     if (interior) {
-      // No wrap, no bounds: the 3 x 3 x 3 neighbourhood straight from the volume.
+      // The 3 x 3 x 3 neighbourhood straight from the volume, x lags as 4 float lanes.
       const float* centre = vb.data + vb.linear(start.x + i, start.y + j, start.z + k);
+      const float lanes[4] = {px[0], px[1], px[2], 0.0f};
       for (int dz = 0; dz < 3; ++dz)
         for (int dy = 0; dy < 3; ++dy) {
           const float f = wa * pz[dz] * py[dy];
           const float* row = centre + (dz - 1) * sz + (dy - 1) * sy - 1;
-          const int l = 3 * (dy + 3 * dz);
-          const float f0 = f * px[0], f1 = f * px[1], f2 = f * px[2];
-          p[l] += f0 * row[0];
-          p[l + 1] += f1 * row[1];
-          p[l + 2] += f2 * row[2];
-          qa[l] += f0;
-          qa[l + 1] += f1;
-          qa[l + 2] += f2;
+          float* pr = p4[dy + 3 * dz];
+          float* qr = qa4[dy + 3 * dz];
+#pragma omp simd
+          for (int l = 0; l < 4; ++l) {
+            const float g = f * lanes[l];
+            pr[l] += g * row[l];
+            qr[l] += g;
+          }
         }
       continue;
     }
@@ -221,6 +224,11 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
           qa[l] += f;
         }
   }
+  for (int r = 0; r < 9; ++r)
+    for (int l = 0; l < 3; ++l) {
+      p[3 * r + l] += p4[r][l];
+      qa[3 * r + l] += qa4[r][l];
+    }
   // R(s) = sum w(x) w(x+s) (A(x) - mean_a) (B(x+s) - mean_b), expanded.
   auto combine = [&](double p_s, double qa_s, double qb_s, int dx, int dy, int dz) {
     const double k = kx_[dx + 2] * ky_[dy + 2] * kz_[dz + 2];

@@ -12,6 +12,13 @@ namespace {
 
 int thread_count(int threads) { return threads > 0 ? threads : omp_get_max_threads(); }
 
+// floor() as an int without the libm call (x86-64 without SSE4.1 has no rounding instruction);
+// the same value as std::floor for the coordinates used here (|x| far below 2^31).
+inline int floor_int(float x) {
+  const int t = static_cast<int>(x);
+  return t - (x < static_cast<float>(t));
+}
+
 // One line of the recursive cubic B-spline prefilter (pole sqrt(3) - 2, mirror boundaries).
 void prefilter_line(float* c, int n) {
   if (n < 2) return;
@@ -70,7 +77,7 @@ void prefilter_rows(float* base, std::size_t stride, int n, int width) {
 }
 
 float sample_trilinear(const VolumeView& v, float x, float y, float z) {
-  const int i = static_cast<int>(std::floor(x)), j = static_cast<int>(std::floor(y)), k = static_cast<int>(std::floor(z));
+  const int i = floor_int(x), j = floor_int(y), k = floor_int(z);
   const float fx = x - i, fy = y - j, fz = z - k;
   float result = 0.0f;
   for (int dk = 0; dk <= 1; ++dk) {
@@ -108,7 +115,7 @@ int mirror(int i, int n) {
 
 float sample_bspline(const VolumeView& c, float x, float y, float z) {
   if (x < -0.5f || y < -0.5f || z < -0.5f || x > c.nx - 0.5f || y > c.ny - 0.5f || z > c.nz - 0.5f) return 0.0f;
-  const int i = static_cast<int>(std::floor(x)), j = static_cast<int>(std::floor(y)), k = static_cast<int>(std::floor(z));
+  const int i = floor_int(x), j = floor_int(y), k = floor_int(z);
   float wx[4], wy[4], wz[4];
   bspline_weights(x - i, wx);
   bspline_weights(y - j, wy);
@@ -145,9 +152,9 @@ float sample_bspline(const VolumeView& c, float x, float y, float z) {
 // the volume the sample is 0 anyway except within half a voxel, which the clamp keeps.
 bool has_signal(const std::vector<std::uint8_t>& support, const VolumeView& v, float x, float y, float z) {
   if (support.empty()) return true;
-  const int i = std::clamp(static_cast<int>(std::floor(x + 0.5f)), 0, v.nx - 1);
-  const int j = std::clamp(static_cast<int>(std::floor(y + 0.5f)), 0, v.ny - 1);
-  const int k = std::clamp(static_cast<int>(std::floor(z + 0.5f)), 0, v.nz - 1);
+  const int i = std::clamp(floor_int(x + 0.5f), 0, v.nx - 1);
+  const int j = std::clamp(floor_int(y + 0.5f), 0, v.ny - 1);
+  const int k = std::clamp(floor_int(z + 0.5f), 0, v.nz - 1);
   return support[v.linear(i, j, k)] != 0;
 }
 
