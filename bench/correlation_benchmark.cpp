@@ -57,6 +57,8 @@ void report_counters(benchmark::State& state, const tomorig::piv::CorrelationOpt
     state.counters["ts_" + tag + "_load"] = r.thread_seconds_load;
     state.counters["ts_" + tag + "_corr"] = r.thread_seconds_correlation;
     state.counters["ts_" + tag + "_peak"] = r.thread_seconds_peak;
+    state.counters["direct_" + tag] = std::string(r.method) == "direct";
+    state.counters["occupied_" + tag] = r.occupied_fraction;
   }
   state.counters["valid_fraction"] = report.valid_fraction();
   const tomorig::piv::FftFloor floor = tomorig::piv::measure_fft_floor(thesis_pair().a.grid, options);

@@ -97,6 +97,7 @@ nlohmann::json to_json(const piv::CorrelationReport& r) {
                       {"empty_windows", p.empty_windows},
                       {"method", p.method},
                       {"fft_fallbacks", p.fft_fallbacks},
+                      {"occupied_fraction", p.occupied_fraction},
                       {"seconds", p.seconds},
                       {"seconds_deformation", p.seconds_deformation},
                       {"seconds_windows", p.seconds_windows},

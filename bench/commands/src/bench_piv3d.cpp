@@ -162,9 +162,10 @@ void print_breakdown(const piv::CorrelationReport& report, const piv::FftFloor& 
   for (std::size_t p = 0; p < report.passes.size(); ++p) {
     const piv::PassReport& r = report.passes[p];
     fmt::print(stderr,
-               "    pass {} ({}, {} x {} x {} nodes, {} empty): {:.2f} s = deformation {:.2f} + windows {:.2f} + "
-               "validation {:.2f}; window thread-s: load {:.2f}, {} {:.2f}, peak {:.2f}; FFT floor {:.2f} s\n",
-               p, r.method, r.nodes_x, r.nodes_y, r.nodes_z, r.empty_windows, r.seconds, r.seconds_deformation,
+               "    pass {} ({}, {} x {} x {} nodes, {} empty, {:.1f} % occupied, {} by FFT): {:.2f} s = deformation {:.2f} + "
+               "windows {:.2f} + validation {:.2f}; window thread-s: load {:.2f}, {} {:.2f}, peak {:.2f}; FFT floor {:.2f} s\n",
+               p, r.method, r.nodes_x, r.nodes_y, r.nodes_z, r.empty_windows, 100.0 * r.occupied_fraction, r.fft_fallbacks,
+               r.seconds, r.seconds_deformation,
                r.seconds_windows, r.seconds_validation, r.thread_seconds_load, r.method, r.thread_seconds_correlation,
                r.thread_seconds_peak, p < floor.pass_seconds.size() ? floor.pass_seconds[p] : 0.0);
   }

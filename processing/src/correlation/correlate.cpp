@@ -165,7 +165,8 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
     if (deform && pass.method != CorrelationMethod::fft && g.window.x >= 8 && g.window.y >= 8 && g.window.z >= 8) {
       detail::list_occupied(va, g.step, detail::kOccupiedThreshold, threads, level.occupied_a);
       detail::list_occupied(vb, g.step, detail::kOccupiedThreshold, threads, level.occupied_b);
-      direct = use_direct(pass, g.window, deform, 0.5 * (occupied_a.occupied_fraction + occupied_b.occupied_fraction));
+      pr.occupied_fraction = 0.5 * (occupied_a.occupied_fraction + occupied_b.occupied_fraction);
+      direct = use_direct(pass, g.window, deform, pr.occupied_fraction);
     }
     std::optional<detail::DirectCorrelator> direct_correlator;
     if (direct) direct_correlator.emplace(g.window, options.weighting, options.gaussian_sigma);

@@ -22,6 +22,8 @@ struct PassReport {
   std::size_t empty_windows = 0;     // windows without contrast, skipped before any correlation
   const char* method = "fft";        // how the windows were correlated: "fft" or "direct"
   std::size_t fft_fallbacks = 0;     // direct pass: windows whose peak lay beyond lag +-1, done by FFT
+  double occupied_fraction = 0.0;    // deformation pass: voxels of the deformed pair above the
+                                     // occupancy threshold (the direct/FFT choice), else 0
   // Time breakdown (wall seconds of the pass's stages, on the calling thread):
   double seconds = 0.0;              // the whole pass
   double seconds_deformation = 0.0;  // binning, B-spline prefilter and volume deformation
