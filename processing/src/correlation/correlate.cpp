@@ -162,7 +162,10 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
     const detail::OccupiedVoxels& occupied_a = level.occupied_a;
     const detail::OccupiedVoxels& occupied_b = level.occupied_b;
     bool direct = false;
-    if (deform && pass.method != CorrelationMethod::fft && g.window.x >= 8 && g.window.y >= 8 && g.window.z >= 8) {
+    // (Entries store 16-bit coordinates: larger volumes keep the FFT.)
+    const bool listable = va.nx <= 65535 && va.ny <= 65535 && va.nz <= 65535;
+    if (deform && listable && pass.method != CorrelationMethod::fft && g.window.x >= 8 && g.window.y >= 8 &&
+        g.window.z >= 8) {
       detail::list_occupied(va, g.step, detail::kOccupiedThreshold, threads, level.occupied_a);
       detail::list_occupied(vb, g.step, detail::kOccupiedThreshold, threads, level.occupied_b);
       pr.occupied_fraction = 0.5 * (occupied_a.occupied_fraction + occupied_b.occupied_fraction);
