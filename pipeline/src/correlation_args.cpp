@@ -94,7 +94,17 @@ nlohmann::json to_json(const piv::CorrelationReport& r) {
                       {"replaced", p.replaced},
                       {"masked", p.masked},
                       {"peak_fallbacks", p.peak_fallbacks},
-                      {"seconds", p.seconds}});
+                      {"empty_windows", p.empty_windows},
+                      {"method", p.method},
+                      {"fft_fallbacks", p.fft_fallbacks},
+                      {"occupied_fraction", p.occupied_fraction},
+                      {"seconds", p.seconds},
+                      {"seconds_deformation", p.seconds_deformation},
+                      {"seconds_windows", p.seconds_windows},
+                      {"seconds_validation", p.seconds_validation},
+                      {"thread_seconds_load", p.thread_seconds_load},
+                      {"thread_seconds_correlation", p.thread_seconds_correlation},
+                      {"thread_seconds_peak", p.thread_seconds_peak}});
   return {{"passes", passes},
           {"seconds_total", r.seconds_total},
           {"valid", r.valid},

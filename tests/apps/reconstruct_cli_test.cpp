@@ -141,6 +141,24 @@ TEST(BenchPiv3dCli, ReducedTruthCaseMeetsTheNoiseFreeReferenceAndPrintsTheDocume
   EXPECT_LE(result["rms_magnitude_voxel"].get<double>(), result["rms_error_vector_voxel"].get<double>());
   EXPECT_GT(result["rms_magnitude_voxel"].get<double>(), 0.0);
   EXPECT_GE(result["valid_fraction"].get<double>(), 0.99);
+  // Issue 19: the time breakdown per pass and the FFT floor measured in the same run. The truth
+  // volumes are sparse (~3 % occupied), so the deformation passes correlate directly.
+  EXPECT_GT(result["seconds_fft_floor"].get<double>(), 0.0);
+  EXPECT_GT(result["ratio_to_fft_floor"].get<double>(), 0.0);
+  const nlohmann::json& passes = result["correlation_report"]["passes"];
+  ASSERT_EQ(passes.size(), 4u);
+  for (const nlohmann::json& pass : passes) {
+    for (const char* key : {"seconds", "seconds_deformation", "seconds_windows", "seconds_validation",
+                            "thread_seconds_load", "thread_seconds_correlation", "thread_seconds_peak",
+                            "empty_windows", "fft_fallbacks", "occupied_fraction"})
+      EXPECT_TRUE(pass.contains(key)) << key;
+    EXPECT_LE(pass["seconds_deformation"].get<double>() + pass["seconds_windows"].get<double>() +
+                  pass["seconds_validation"].get<double>(),
+              pass["seconds"].get<double>() + 1e-6);
+  }
+  EXPECT_EQ(passes[1]["method"], "fft");     // integer offset: displacements of several voxels
+  EXPECT_EQ(passes[3]["method"], "direct");  // residual after deformation, sparse volumes
+  EXPECT_LT(passes[3]["occupied_fraction"].get<double>(), 0.08);
 }
 
 // Refused up front, before the case is rendered.

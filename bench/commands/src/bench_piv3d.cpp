@@ -21,6 +21,7 @@
 #include "tomorig/pipeline/report_json.h"
 #include "tomorig/pipeline/session_geometry.h"
 #include "tomorig/core/error.h"
+#include "tomorig/processing/correlation/correlate.h"
 #include "tomorig/processing/reconstruction/reconstructor.h"
 #include "tomorig/processing/reconstruction/smoothing.h"
 #include "tomorig/simulators/simulated_rig.h"
@@ -156,6 +157,20 @@ void write_errors_csv(const std::string& path, const std::string& source, double
   std::fclose(out);
 }
 
+// Per pass: where the correlation's time went, beside the pass's FFT floor.
+void print_breakdown(const piv::CorrelationReport& report, const piv::FftFloor& floor) {
+  for (std::size_t p = 0; p < report.passes.size(); ++p) {
+    const piv::PassReport& r = report.passes[p];
+    fmt::print(stderr,
+               "    pass {} ({}, {} x {} x {} nodes, {} empty, {:.1f} % occupied, {} by FFT): {:.2f} s = deformation {:.2f} + "
+               "windows {:.2f} + validation {:.2f}; window thread-s: load {:.2f}, {} {:.2f}, peak {:.2f}; FFT floor {:.2f} s\n",
+               p, r.method, r.nodes_x, r.nodes_y, r.nodes_z, r.empty_windows, 100.0 * r.occupied_fraction, r.fft_fallbacks,
+               r.seconds, r.seconds_deformation,
+               r.seconds_windows, r.seconds_validation, r.thread_seconds_load, r.method, r.thread_seconds_correlation,
+               r.thread_seconds_peak, p < floor.pass_seconds.size() ? floor.pass_seconds[p] : 0.0);
+  }
+}
+
 // The options of a reconstructed source, validated (tomorig::Error naming a bad field).
 recon::ReconstructionOptions reconstruction_options(const BenchPiv3dArgs& args, const std::string& source) {
   recon::ReconstructionOptions o;
@@ -240,12 +255,18 @@ void run(const BenchPiv3dArgs& args) {
       piv::CorrelationReport report;
       const VectorField field = piv::correlate(a, b, options, report);
       const double total = std::chrono::duration<double>(Clock::now() - start).count();
+      // The floor in the same run, same threads and windows: the FFTs alone.
+      const piv::FftFloor floor = piv::measure_fft_floor(grid, options);
+      const double floor_ratio = floor.seconds_total > 0 ? report.seconds_total / floor.seconds_total : 0.0;
       const FieldError e = judge(field, rig.flow(), grid.voxel_size);
       if (!args.errors_csv.empty()) write_errors_csv(args.errors_csv, source, ppp, field, rig.flow(), grid);
       fmt::print(stderr, "  {:6} RMS magnitude {:.3f} voxel, error vector {:.3f} (x {:.3f}, y {:.3f}, z {:.3f}), {:.1f} % valid, "
                          "correlation {:.1f} s, total {:.1f} s\n",
                  source, e.rms_magnitude, e.rms_error_vector, e.rms.x, e.rms.y, e.rms.z, 100.0 * e.valid_fraction,
                  report.seconds_total, total);
+      print_breakdown(report, floor);
+      fmt::print(stderr, "  {:6} correlation {:.2f} s = {:.2f} x its FFT floor ({:.2f} s measured now)\n", source,
+                 report.seconds_total, floor_ratio, floor.seconds_total);
       results.push_back({{"source", source},
                          {"ppp", ppp},
                          {"rms_voxel", {e.rms.x, e.rms.y, e.rms.z}},
@@ -254,6 +275,9 @@ void run(const BenchPiv3dArgs& args) {
                          {"valid_fraction", e.valid_fraction},
                          {"seconds_correlation", report.seconds_total},
                          {"seconds_final_pass", report.passes.empty() ? 0.0 : report.passes.back().seconds},
+                         {"seconds_fft_floor", floor.seconds_total},
+                         {"fft_floor_pass_seconds", floor.pass_seconds},
+                         {"ratio_to_fft_floor", floor_ratio},
                          {"seconds_total", total},
                          {"interior_nodes", e.nodes},
                          {"window", {w.x, w.y, w.z}},

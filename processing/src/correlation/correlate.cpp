@@ -4,10 +4,13 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <map>
+#include <optional>
 
 #include <fmt/core.h>
 
+#include "correlation/direct_correlator.h"
 #include "correlation/fft_correlator.h"
 #include "correlation/predictor_filters.h"
 #include "correlation/volume_deformation.h"
@@ -26,6 +29,8 @@ struct Level {
   VolumeView view_a, view_b;
   std::vector<float> coef_a, coef_b;    // cubic B-spline coefficients, empty until needed
   std::vector<float> deformed_a, deformed_b;
+  std::vector<std::uint8_t> support_a, support_b;  // signal_support of a and b, empty until needed
+  detail::OccupiedVoxels occupied_a, occupied_b;   // of the deformed pair, memory reused by each pass
 };
 
 // Where the windows of a pass sit, in voxels of its (binned) level.
@@ -47,6 +52,18 @@ PassGeometry geometry_of(const CorrelationPass& pass, const VolumeView& level) {
   g.nodes = {(level.nx - g.window.x) / g.step.x + 1, (level.ny - g.window.y) / g.step.y + 1,
              (level.nz - g.window.z) / g.step.z + 1};
   return g;
+}
+
+// Above this mean fraction of occupied voxels in the deformed pair, the direct correlation's
+// gathers cost more than the FFTs of a window (estimated from the operation counts: 3 x 27
+// products per occupied voxel against three N log N transforms, with a margin for the
+// gathers); a deterministic choice, so every process picks the same method.
+constexpr double kDirectMaxOccupancy = 0.08;
+
+bool use_direct(const CorrelationPass& pass, Int3 window, bool deform, double occupancy) {
+  if (!deform || pass.method == CorrelationMethod::fft) return false;
+  if (window.x < 8 || window.y < 8 || window.z < 8) return false;  // lags +-2 must not reach the wrap
+  return pass.method == CorrelationMethod::direct || occupancy <= kDirectMaxOccupancy;
 }
 
 bool same_grid(const VoxelGrid& a, const VoxelGrid& b) {
@@ -104,6 +121,7 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
   VectorField field;
   for (std::size_t p = 0; p < options.passes.size(); ++p) {
     const auto start_pass = std::chrono::steady_clock::now();
+    PassReport pr;
     const CorrelationPass& pass = options.passes[p];
     Level& level = level_for(pass.downsample);
     const PassGeometry g = geometry_of(pass, level.view_a);
@@ -121,21 +139,48 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
         va.data = level.coef_a.data();
         vb.data = level.coef_b.data();
       }
-      detail::deform_pair(va, vb, predictor, g.factor, pass.interpolation, level.deformed_a, level.deformed_b, threads);
+      // Where the samples have signal: made once per level, reused by every deformation pass.
+      if (level.support_a.empty()) {
+        level.support_a = detail::signal_support(level.view_a, detail::kOccupiedThreshold, detail::kSupportRadius, threads);
+        level.support_b = detail::signal_support(level.view_b, detail::kOccupiedThreshold, detail::kSupportRadius, threads);
+      }
+      detail::deform_pair(va, vb, predictor, g.factor, pass.interpolation, level.deformed_a, level.deformed_b, threads,
+                          level.support_a, level.support_b);
       va.data = level.deformed_a.data();
       vb.data = level.deformed_b.data();
     }
+    pr.seconds_deformation = seconds_since(start_pass);
+    const auto start_windows = std::chrono::steady_clock::now();
 
     field = VectorField(g.nodes.x, g.nodes.y, g.nodes.z);
     field.origin = {g.centre(0, g.step.x, g.window.x), g.centre(0, g.step.y, g.window.y), g.centre(0, g.step.z, g.window.z)};
     field.spacing = {double(g.factor * g.step.x), double(g.factor * g.step.y), double(g.factor * g.step.z)};
 
     const detail::FftCorrelator correlator(g.window, options.weighting, options.gaussian_sigma);
+    // Sparse direct correlation of the deformation passes: the occupied voxels listed once, in
+    // blocks of the window step that the overlapping windows share.
+    const detail::OccupiedVoxels& occupied_a = level.occupied_a;
+    const detail::OccupiedVoxels& occupied_b = level.occupied_b;
+    bool direct = false;
+    // (Entries store 16-bit coordinates: larger volumes keep the FFT.)
+    const bool listable = va.nx <= 65535 && va.ny <= 65535 && va.nz <= 65535;
+    if (deform && listable && pass.method != CorrelationMethod::fft && g.window.x >= 8 && g.window.y >= 8 &&
+        g.window.z >= 8) {
+      detail::list_occupied(va, g.step, detail::kOccupiedThreshold, threads, level.occupied_a);
+      detail::list_occupied(vb, g.step, detail::kOccupiedThreshold, threads, level.occupied_b);
+      pr.occupied_fraction = 0.5 * (occupied_a.occupied_fraction + occupied_b.occupied_fraction);
+      direct = use_direct(pass, g.window, deform, pr.occupied_fraction);
+    }
+    std::optional<detail::DirectCorrelator> direct_correlator;
+    if (direct) direct_correlator.emplace(g.window, options.weighting, options.gaussian_sigma);
+    pr.method = direct ? "direct" : "fft";
     const long long node_count = static_cast<long long>(field.count());
-    std::size_t fallbacks = 0;
-#pragma omp parallel num_threads(threads) reduction(+ : fallbacks)
+    std::size_t fallbacks = 0, empty = 0, fft_fallbacks = 0;
+    double load = 0, correlation = 0, peak_fit = 0;
+#pragma omp parallel num_threads(threads) reduction(+ : fallbacks, empty, fft_fallbacks, load, correlation, peak_fit)
     {
       auto scratch = correlator.make_scratch();  // once per thread and pass, never per window
+      detail::DirectCorrelator::Scratch direct_scratch;
 #pragma omp for schedule(dynamic, 4)
       for (long long n = 0; n < node_count; ++n) {
         const int i = static_cast<int>(n % g.nodes.x);
@@ -155,15 +200,32 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
                     static_cast<int>(std::lround(predicted.z))};
         const Int3 start_a{start.x - floor_half(offset.x), start.y - floor_half(offset.y), start.z - floor_half(offset.z)};
         const Int3 start_b{start_a.x + offset.x, start_a.y + offset.y, start_a.z + offset.z};
-        const detail::WindowPeak peak = correlator.correlate(va, start_a, vb, start_b, scratch);
+        detail::WindowPeak peak;
+        bool by_fft = !direct;
+        if (direct) {
+          peak = direct_correlator->correlate(occupied_a, vb, occupied_b, start, direct_scratch, by_fft);
+          fft_fallbacks += by_fft;
+        }
+        if (by_fft) peak = correlator.correlate(va, start_a, vb, start_b, scratch);
         fallbacks += peak.fallbacks;
+        empty += peak.empty;
         if (!peak.valid) continue;  // stays invalid with peak 0
         const Vec3f base = deform ? predicted : Vec3f{float(offset.x), float(offset.y), float(offset.z)};
         field.displacement[n] = {(base.x + peak.dx) * g.factor, (base.y + peak.dy) * g.factor, (base.z + peak.dz) * g.factor};
         field.peak[n] = peak.peak;
         field.status[n] = VectorStatus::valid;
       }
+      load += scratch.seconds.load + direct_scratch.seconds.load;
+      correlation += scratch.seconds.correlation + direct_scratch.seconds.correlation;
+      peak_fit += scratch.seconds.peak + direct_scratch.seconds.peak;
     }
+    pr.fft_fallbacks = fft_fallbacks;
+    pr.seconds_windows = seconds_since(start_windows);
+    pr.thread_seconds_load = load;
+    pr.thread_seconds_correlation = correlation;
+    pr.thread_seconds_peak = peak_fit;
+    pr.empty_windows = empty;
+    const auto start_validation = std::chrono::steady_clock::now();
 
     std::vector<std::uint8_t> mask;
     if (options.illumination) {
@@ -178,7 +240,6 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
     }
     const ValidationCounts counts = validate_field(field, options, mask);
 
-    PassReport pr;
     pr.nodes_x = field.nx;
     pr.nodes_y = field.ny;
     pr.nodes_z = field.nz;
@@ -195,6 +256,7 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
       if (options.smooth_predictor) detail::smooth_gaussian3(predictor);
       have_predictor = true;
     }
+    pr.seconds_validation = seconds_since(start_validation);
     pr.seconds = seconds_since(start_pass);
     report.passes.push_back(pr);
   }
@@ -219,6 +281,38 @@ VectorField correlate(const SparseVolume& a, const SparseVolume& b, const Correl
                                 a.grid.nx, a.grid.ny, a.grid.nz, b.grid.nx, b.grid.ny, b.grid.nz));
   options.validate(a.grid);
   return correlate(a.to_dense(), b.to_dense(), options, report);
+}
+
+FftFloor measure_fft_floor(const VoxelGrid& grid, const CorrelationOptions& options) {
+  options.validate(grid);
+  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  FftFloor floor;
+  for (const CorrelationPass& pass : options.passes) {
+    const int f = pass.downsample;
+    const VolumeView level{nullptr, grid.nx / f, grid.ny / f, grid.nz / f};
+    const PassGeometry g = geometry_of(pass, level);
+    const long long windows = static_cast<long long>(g.nodes.x) * g.nodes.y * g.nodes.z;
+    const detail::FftCorrelator correlator(g.window, WindowWeighting::top_hat);
+    const auto start = std::chrono::steady_clock::now();
+#pragma omp parallel num_threads(threads)
+    {
+      auto scratch = correlator.make_scratch();
+      // Particle-like data (not zeros: FFTW's speed does not depend on the values, but
+      // subnormals would), the same in every thread.
+      const std::size_t count = static_cast<std::size_t>(g.window.x) * g.window.y * g.window.z;
+      std::uint32_t state = 12345u;
+      for (std::size_t m = 0; m < count; ++m) {
+        state = state * 1664525u + 1013904223u;
+        scratch.a.get()[m] = static_cast<float>(state >> 8) * (1.0f / 16777216.0f);
+        scratch.b.get()[m] = scratch.a.get()[(m + 7) % count];
+      }
+#pragma omp for schedule(dynamic, 4)
+      for (long long n = 0; n < windows; ++n) correlator.transforms_only(scratch);
+    }
+    floor.pass_seconds.push_back(seconds_since(start));
+    floor.seconds_total += floor.pass_seconds.back();
+  }
+  return floor;
 }
 
 }  // namespace tomorig::piv

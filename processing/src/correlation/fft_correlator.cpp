@@ -3,6 +3,7 @@
 #include <fftw3.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -52,6 +53,15 @@ const PlanPair& plans_for(Int3 w) {
   return it->second;
 }
 
+int signed_lag(int index, int size) { return index < size / 2 ? index : index - size; }
+
+using Clock = std::chrono::steady_clock;
+double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+
+}  // namespace
+
+void FftwFree::operator()(void* p) const { fftwf_free(p); }
+
 std::vector<float> axis_weights(int n, WindowWeighting weighting, double gaussian_sigma) {
   std::vector<float> w(n, 1.0f);
   const double centre = 0.5 * (n - 1);
@@ -65,11 +75,6 @@ std::vector<float> axis_weights(int n, WindowWeighting weighting, double gaussia
   return w;
 }
 
-int signed_lag(int index, int size) { return index < size / 2 ? index : index - size; }
-
-}  // namespace
-
-void FftwFree::operator()(void* p) const { fftwf_free(p); }
 
 FftCorrelator::FftCorrelator(Int3 window, WindowWeighting weighting, double gaussian_sigma)
     : window_(window),
@@ -153,10 +158,16 @@ double FftCorrelator::load_window(const VolumeView& v, Int3 start, float* out) c
 WindowPeak FftCorrelator::correlate(const VolumeView& va, Int3 start_a, const VolumeView& vb, Int3 start_b,
                                     Scratch& s) const {
   WindowPeak result;
+  const auto t0 = Clock::now();
   const double energy_a = load_window(va, start_a, s.a.get());
   const double energy_b = load_window(vb, start_b, s.b.get());
+  const auto t1 = Clock::now();
+  s.seconds.load += seconds_between(t0, t1);
   // A window without contrast has no defined correlation coefficient (Eq. 2.16 divides by 0).
-  if (!(energy_a > 1e-20) || !(energy_b > 1e-20)) return result;
+  if (!(energy_a > 1e-20) || !(energy_b > 1e-20)) {
+    result.empty = true;
+    return result;
+  }
 
   const auto& plans = *static_cast<const PlanPair*>(plans_);
   auto* fa = reinterpret_cast<fftwf_complex*>(s.spectrum_a.get());
@@ -171,6 +182,13 @@ WindowPeak FftCorrelator::correlate(const VolumeView& va, Int3 start_a, const Vo
   }
   float* plane = s.a.get();
   fftwf_execute_dft_c2r(plans.backward, fa, plane);
+  const auto t2 = Clock::now();
+  s.seconds.correlation += seconds_between(t1, t2);
+  struct PeakClock {  // charges the peak search and fit, whichever return is taken
+    Clock::time_point start;
+    double& sum;
+    ~PeakClock() { sum += seconds_between(start, Clock::now()); }
+  } peak_clock{t2, s.seconds.peak};
 
   // The first highest value: a vectorised maximum, then its first position.
   float best_value = plane[0];
@@ -205,6 +223,16 @@ WindowPeak FftCorrelator::correlate(const VolumeView& va, Int3 start_a, const Vo
   result.peak = static_cast<float>(centre * scale);
   result.valid = true;
   return result;
+}
+
+void FftCorrelator::transforms_only(Scratch& s) const {
+  const auto& plans = *static_cast<const PlanPair*>(plans_);
+  auto* fa = reinterpret_cast<fftwf_complex*>(s.spectrum_a.get());
+  auto* fb = reinterpret_cast<fftwf_complex*>(s.spectrum_b.get());
+  fftwf_execute_dft_r2c(plans.forward, s.a.get(), fa);
+  fftwf_execute_dft_r2c(plans.forward, s.b.get(), fb);
+  // Into spectrum_b's memory (large enough): a and b stay the inputs of every repetition.
+  fftwf_execute_dft_c2r(plans.backward, fa, s.spectrum_b.get());
 }
 
 }  // namespace tomorig::piv::detail

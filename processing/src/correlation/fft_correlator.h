@@ -20,7 +20,16 @@ struct WindowPeak {
   float peak = 0;                // correlation coefficient at the integer peak
   int fallbacks = 0;             // axes not fitted by the 3-point Gaussian
   bool valid = false;            // false if a window has no contrast (zero variance)
+  bool empty = false;            // no contrast: skipped before correlating
 };
+
+// Thread-seconds of one thread's windows, by stage (PassReport's breakdown).
+struct StageSeconds {
+  double load = 0, correlation = 0, peak = 0;
+};
+
+// The weights of one axis of a window (the window's weights are the product of the three).
+std::vector<float> axis_weights(int n, WindowWeighting weighting, double gaussian_sigma);
 
 class FftCorrelator {
  public:
@@ -31,12 +40,17 @@ class FftCorrelator {
   struct Scratch {
     std::unique_ptr<float, FftwFree> a, b;
     std::unique_ptr<float, FftwFree> spectrum_a, spectrum_b;  // interleaved complex
+    StageSeconds seconds;                                      // accumulated by correlate()
   };
   Scratch make_scratch() const;
 
   // Correlates the window of `va` starting at `start_a` with that of `vb` at `start_b`;
   // voxels outside a volume count as 0.
   WindowPeak correlate(const VolumeView& va, Int3 start_a, const VolumeView& vb, Int3 start_b, Scratch& scratch) const;
+
+  // The FFTs of one window pair alone (two forward, one inverse) on the scratch buffers as they
+  // are: the floor figure of measure_fft_floor.
+  void transforms_only(Scratch& scratch) const;
 
  private:
   // Copies the window into `out`, subtracts its mean and applies the weights; returns sum(out^2).

@@ -12,6 +12,13 @@ namespace {
 
 int thread_count(int threads) { return threads > 0 ? threads : omp_get_max_threads(); }
 
+// floor() as an int without the libm call (x86-64 without SSE4.1 has no rounding instruction);
+// the same value as std::floor for the coordinates used here (|x| far below 2^31).
+inline int floor_int(float x) {
+  const int t = static_cast<int>(x);
+  return t - (x < static_cast<float>(t));
+}
+
 // One line of the recursive cubic B-spline prefilter (pole sqrt(3) - 2, mirror boundaries).
 void prefilter_line(float* c, int n) {
   if (n < 2) return;
@@ -70,7 +77,7 @@ void prefilter_rows(float* base, std::size_t stride, int n, int width) {
 }
 
 float sample_trilinear(const VolumeView& v, float x, float y, float z) {
-  const int i = static_cast<int>(std::floor(x)), j = static_cast<int>(std::floor(y)), k = static_cast<int>(std::floor(z));
+  const int i = floor_int(x), j = floor_int(y), k = floor_int(z);
   const float fx = x - i, fy = y - j, fz = z - k;
   float result = 0.0f;
   for (int dk = 0; dk <= 1; ++dk) {
@@ -108,7 +115,7 @@ int mirror(int i, int n) {
 
 float sample_bspline(const VolumeView& c, float x, float y, float z) {
   if (x < -0.5f || y < -0.5f || z < -0.5f || x > c.nx - 0.5f || y > c.ny - 0.5f || z > c.nz - 0.5f) return 0.0f;
-  const int i = static_cast<int>(std::floor(x)), j = static_cast<int>(std::floor(y)), k = static_cast<int>(std::floor(z));
+  const int i = floor_int(x), j = floor_int(y), k = floor_int(z);
   float wx[4], wy[4], wz[4];
   bspline_weights(x - i, wx);
   bspline_weights(y - j, wy);
@@ -141,7 +148,27 @@ float sample_bspline(const VolumeView& c, float x, float y, float z) {
   return result;
 }
 
+// Whether the support mask (empty: everywhere) marks the voxel nearest to (x, y, z); outside
+// the volume the sample is 0 anyway except within half a voxel, which the clamp keeps.
+bool has_signal(const std::vector<std::uint8_t>& support, const VolumeView& v, float x, float y, float z) {
+  if (support.empty()) return true;
+  const int i = std::clamp(floor_int(x + 0.5f), 0, v.nx - 1);
+  const int j = std::clamp(floor_int(y + 0.5f), 0, v.ny - 1);
+  const int k = std::clamp(floor_int(z + 0.5f), 0, v.nz - 1);
+  return support[v.linear(i, j, k)] != 0;
+}
+
 }  // namespace
+
+void locate_axis(double p, double origin, double spacing, int n, int& i0, double& frac) {
+  double u = spacing > 0 ? (p - origin) / spacing : 0.0;
+  // Beyond the outermost nodes: linear extrapolation of the end cell, for at most one node
+  // spacing (the outermost half window). A constant there (the old rule) deforms the
+  // boundary windows with the wrong gradient and biased the next-to-boundary nodes.
+  u = std::clamp(u, -1.0, static_cast<double>(n));
+  i0 = std::clamp(static_cast<int>(std::floor(u)), 0, std::max(n - 2, 0));
+  frac = n > 1 ? u - i0 : 0.0;
+}
 
 std::vector<float> downsample_sum(const VolumeView& v, int factor, int threads) {
   const int nx = v.nx / factor, ny = v.ny / factor, nz = v.nz / factor;
@@ -180,20 +207,11 @@ void bspline_prefilter(std::vector<float>& values, int nx, int ny, int nz, int t
 }
 
 Vec3f sample_field(const VectorField& f, double x, double y, double z) {
-  auto locate = [](double p, double origin, double spacing, int n, int& i0, double& frac) {
-    double u = spacing > 0 ? (p - origin) / spacing : 0.0;
-    // Beyond the outermost nodes: linear extrapolation of the end cell, for at most one node
-    // spacing (the outermost half window). A constant there (the old rule) deforms the
-    // boundary windows with the wrong gradient and biased the next-to-boundary nodes.
-    u = std::clamp(u, -1.0, static_cast<double>(n));
-    i0 = std::clamp(static_cast<int>(std::floor(u)), 0, std::max(n - 2, 0));
-    frac = n > 1 ? u - i0 : 0.0;
-  };
   int i, j, k;
   double fx, fy, fz;
-  locate(x, f.origin.x, f.spacing.x, f.nx, i, fx);
-  locate(y, f.origin.y, f.spacing.y, f.ny, j, fy);
-  locate(z, f.origin.z, f.spacing.z, f.nz, k, fz);
+  locate_axis(x, f.origin.x, f.spacing.x, f.nx, i, fx);
+  locate_axis(y, f.origin.y, f.spacing.y, f.ny, j, fy);
+  locate_axis(z, f.origin.z, f.spacing.z, f.nz, k, fz);
   double r[3] = {0, 0, 0};
   for (int dk = 0; dk <= 1; ++dk) {
     const double wz = dk ? fz : 1.0 - fz;
@@ -214,8 +232,99 @@ Vec3f sample_field(const VectorField& f, double x, double y, double z) {
   return {static_cast<float>(r[0]), static_cast<float>(r[1]), static_cast<float>(r[2])};
 }
 
+void RowPredictor::set_row(double y, double z) {
+  int j, k;
+  double fy, fz;
+  locate_axis(y, f_.origin.y, f_.spacing.y, f_.ny, j, fy);
+  locate_axis(z, f_.origin.z, f_.spacing.z, f_.nz, k, fz);
+  columns_.assign(3 * static_cast<std::size_t>(f_.nx), 0.0);
+  for (int dk = 0; dk <= 1; ++dk) {
+    const double wz = dk ? fz : 1.0 - fz;
+    if (wz == 0.0 || (f_.nz == 1 && dk)) continue;
+    for (int dj = 0; dj <= 1; ++dj) {
+      const double wy = dj ? fy : 1.0 - fy;
+      if (wy == 0.0 || (f_.ny == 1 && dj)) continue;
+      const double w = wz * wy;
+      for (int i = 0; i < f_.nx; ++i) {
+        const Vec3f& d = f_.displacement[f_.linear(i, j + dj, k + dk)];
+        columns_[3 * i] += w * d.x;
+        columns_[3 * i + 1] += w * d.y;
+        columns_[3 * i + 2] += w * d.z;
+      }
+    }
+  }
+}
+
+Vec3f RowPredictor::at(double x) const {
+  int i;
+  double fx;
+  locate_axis(x, f_.origin.x, f_.spacing.x, f_.nx, i, fx);
+  double r[3] = {0, 0, 0};
+  for (int di = 0; di <= 1; ++di) {
+    const double w = di ? fx : 1.0 - fx;
+    if (w == 0.0 || (f_.nx == 1 && di)) continue;
+    const double* c = columns_.data() + 3 * static_cast<std::size_t>(i + di);
+    r[0] += w * c[0];
+    r[1] += w * c[1];
+    r[2] += w * c[2];
+  }
+  return {static_cast<float>(r[0]), static_cast<float>(r[1]), static_cast<float>(r[2])};
+}
+
+std::vector<std::uint8_t> signal_support(const VolumeView& v, float relative_threshold, int radius, int threads) {
+  const int t = thread_count(threads);
+  const std::size_t count = v.count();
+  float largest = 0.0f;
+#pragma omp parallel for num_threads(t) reduction(max : largest) schedule(static)
+  for (long long n = 0; n < static_cast<long long>(count); ++n) largest = std::max(largest, std::abs(v.data[n]));
+  const float threshold = relative_threshold * largest;
+  std::vector<std::uint8_t> mask(count), spread(count);
+  // Dilation by `radius` as three separable maxima (x, then y, then z) of width 2 radius + 1.
+  const std::size_t sy = v.nx, sz = static_cast<std::size_t>(v.nx) * v.ny;
+#pragma omp parallel num_threads(t)
+  {
+#pragma omp for schedule(static)
+    for (int k = 0; k < v.nz; ++k)
+      for (int j = 0; j < v.ny; ++j) {
+        const float* src = v.data + j * sy + k * sz;
+        std::uint8_t* dst = spread.data() + j * sy + k * sz;
+        int last = -1000000;  // last x above the threshold
+        for (int i = 0; i < v.nx + radius; ++i) {
+          if (i < v.nx && std::abs(src[i]) > threshold) last = i;
+          const int x = i - radius;
+          if (x >= 0) dst[x] = (i - last) <= 2 * radius;
+        }
+      }
+    // y: row k*sz + j*sy of mask = OR of spread rows j - r .. j + r.
+#pragma omp for schedule(static)
+    for (int k = 0; k < v.nz; ++k)
+      for (int j = 0; j < v.ny; ++j) {
+        std::uint8_t* dst = mask.data() + j * sy + k * sz;
+        std::fill(dst, dst + v.nx, std::uint8_t{0});
+        for (int jj = std::max(0, j - radius); jj <= std::min(v.ny - 1, j + radius); ++jj) {
+          const std::uint8_t* src = spread.data() + jj * sy + k * sz;
+#pragma omp simd
+          for (int i = 0; i < v.nx; ++i) dst[i] |= src[i];
+        }
+      }
+    // z: into spread, then the result is spread.
+#pragma omp for schedule(static)
+    for (int k = 0; k < v.nz; ++k) {
+      std::uint8_t* dst = spread.data() + k * sz;
+      std::fill(dst, dst + sz, std::uint8_t{0});
+      for (int kk = std::max(0, k - radius); kk <= std::min(v.nz - 1, k + radius); ++kk) {
+        const std::uint8_t* src = mask.data() + kk * sz;
+#pragma omp simd
+        for (std::size_t m = 0; m < sz; ++m) dst[m] |= src[m];
+      }
+    }
+  }
+  return spread;
+}
+
 void deform_pair(const VolumeView& a, const VolumeView& b, const VectorField& predictor, int factor,
-                 Interpolation interpolation, std::vector<float>& out_a, std::vector<float>& out_b, int threads) {
+                 Interpolation interpolation, std::vector<float>& out_a, std::vector<float>& out_b, int threads,
+                 const std::vector<std::uint8_t>& support_a, const std::vector<std::uint8_t>& support_b) {
   // Every voxel is written below: size the (reused) buffers without clearing them first.
   out_a.resize(a.count());
   out_b.resize(b.count());
@@ -224,19 +333,23 @@ void deform_pair(const VolumeView& a, const VolumeView& b, const VectorField& pr
 #pragma omp parallel num_threads(thread_count(threads))
   {
   const FlushDenormals flush;
+  RowPredictor along_row(predictor);  // the predictor's y-z interpolation once per row
 #pragma omp for schedule(dynamic, 1)
   for (int k = 0; k < a.nz; ++k)
     for (int j = 0; j < a.ny; ++j) {
       const std::size_t row = a.linear(0, j, k);
+      along_row.set_row(j * factor + offset, k * factor + offset);
       for (int i = 0; i < a.nx; ++i) {
-        const Vec3f d = sample_field(predictor, i * factor + offset, j * factor + offset, k * factor + offset);
+        const Vec3f d = along_row.at(i * factor + offset);
         const float hx = d.x * half, hy = d.y * half, hz = d.z * half;
+        const bool signal_a = has_signal(support_a, a, i - hx, j - hy, k - hz);
+        const bool signal_b = has_signal(support_b, b, i + hx, j + hy, k + hz);
         if (interpolation == Interpolation::trilinear) {
-          out_a[row + i] = sample_trilinear(a, i - hx, j - hy, k - hz);
-          out_b[row + i] = sample_trilinear(b, i + hx, j + hy, k + hz);
+          out_a[row + i] = signal_a ? sample_trilinear(a, i - hx, j - hy, k - hz) : 0.0f;
+          out_b[row + i] = signal_b ? sample_trilinear(b, i + hx, j + hy, k + hz) : 0.0f;
         } else {
-          out_a[row + i] = sample_bspline(a, i - hx, j - hy, k - hz);
-          out_b[row + i] = sample_bspline(b, i + hx, j + hy, k + hz);
+          out_a[row + i] = signal_a ? sample_bspline(a, i - hx, j - hy, k - hz) : 0.0f;
+          out_b[row + i] = signal_b ? sample_bspline(b, i + hx, j + hy, k + hz) : 0.0f;
         }
       }
     }

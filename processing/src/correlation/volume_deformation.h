@@ -2,6 +2,7 @@
 // Volume operations of the multi-grid and deformation passes (thesis Sect. 2.5, 5.4.3):
 // binning by summing N^3 voxels, cubic B-spline prefiltering, and the symmetric deformation
 // of Eq. 2.17.
+#include <cstdint>
 #include <vector>
 
 #include "correlation/volume_view.h"
@@ -17,15 +18,43 @@ std::vector<float> downsample_sum(const VolumeView& v, int factor, int threads);
 // boundaries), so that the spline passes through the samples.
 void bspline_prefilter(std::vector<float>& values, int nx, int ny, int nz, int threads);
 
+// Where a volume has signal: 1 for voxels within `radius` voxels (Chebyshev) of a sample whose
+// magnitude exceeds `relative_threshold` times the volume's largest, else 0.
+std::vector<std::uint8_t> signal_support(const VolumeView& v, float relative_threshold, int radius, int threads);
+
+// The radius of signal_support that deform_pair needs: beyond it the cubic B-spline's
+// interpolant of a sampled particle image (smooth, its outer samples themselves near the
+// threshold) is below the threshold's order, so the sample is 0 without evaluating its 64 taps.
+inline constexpr int kSupportRadius = 3;
+
 // Eq. 2.17 on a volume binned by `factor`: out_a(x) = a(x - d(x)/2), out_b(x) = b(x + d(x)/2),
 // with d the predictor (voxels of the full grid, node centres in full-grid voxel coordinates)
 // interpolated trilinearly at each voxel. `a`/`b` are samples for trilinear interpolation or
 // B-spline coefficients for cubic interpolation. Outside the volume the intensity is 0.
+// `support_a` / `support_b` (signal_support of the samples, may be empty: everywhere) mark
+// where a sample can be non-zero; elsewhere the output is 0 and not interpolated.
 void deform_pair(const VolumeView& a, const VolumeView& b, const VectorField& predictor, int factor,
-                 Interpolation interpolation, std::vector<float>& out_a, std::vector<float>& out_b, int threads);
+                 Interpolation interpolation, std::vector<float>& out_a, std::vector<float>& out_b, int threads,
+                 const std::vector<std::uint8_t>& support_a = {}, const std::vector<std::uint8_t>& support_b = {});
 
 // The predictor at a full-grid voxel position: trilinear between nodes, linearly extrapolated
 // from the end cell up to one node spacing beyond the outermost nodes, constant further out.
 Vec3f sample_field(const VectorField& field, double x, double y, double z);
+
+// sample_field's cell and fraction along one axis.
+void locate_axis(double p, double origin, double spacing, int n, int& i0, double& frac);
+
+// sample_field along one row of voxels: the y-z interpolation is done once per row (set_row),
+// leaving a linear interpolation in x per voxel.
+class RowPredictor {
+ public:
+  explicit RowPredictor(const VectorField& field) : f_(field) {}
+  void set_row(double y, double z);
+  Vec3f at(double x) const;
+
+ private:
+  const VectorField& f_;
+  std::vector<double> columns_;  // per x-node: the displacement interpolated at the row's y, z
+};
 
 }  // namespace tomorig::piv::detail

@@ -11,6 +11,10 @@ namespace tomorig::piv {
 
 enum class WindowWeighting { top_hat, gaussian, hann };
 enum class Interpolation { trilinear, cubic_bspline };
+// How a deformation pass correlates its windows: `automatic` chooses sparse direct correlation
+// (lags -1..1 around the predictor) when the deformed volumes are sparse enough for it to cost
+// less than the FFTs, else FFT; passes without deformation always use the FFT.
+enum class CorrelationMethod { automatic, fft, direct };
 
 struct WindowSize {
   int x = 32, y = 32, z = 32;  // voxels of the full-resolution grid
@@ -22,6 +26,7 @@ struct CorrelationPass {
   int downsample = 1;          // correlate volumes binned by summing N^3 voxels (1, 2 or 4)
   bool deformation = false;    // deform both volumes by -/+ half the predictor (Eq. 2.17)
   Interpolation interpolation = Interpolation::cubic_bspline;
+  CorrelationMethod method = CorrelationMethod::automatic;
 };
 
 // The normalised median test of Westerweel & Scarano (2005) on the 3x3x3 neighbourhood.

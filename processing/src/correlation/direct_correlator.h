@@ -1,0 +1,61 @@
+#pragma once
+// Sparse direct correlation of the deformation passes (thesis Sect. 2.5, Discetti & Astarita):
+// after deformation the residual displacement is sub-voxel, so only the correlation values at
+// lags -1..1 (and the peak's outer neighbours) are needed, and a particle volume is mostly
+// empty. The occupied voxels of a volume (above a small fraction of its maximum) are listed
+// once per pass in blocks of the window step, shared by the overlapping windows; each window
+// then gathers its entries and evaluates Eq. 2.16 with the same weights, means, energies and
+// circular indexing as the FFT path, so where both find the same peak they give the same
+// coefficients (up to rounding and the dropped near-zero voxels).
+#include <cstdint>
+#include <vector>
+
+#include "correlation/fft_correlator.h"
+#include "correlation/volume_view.h"
+#include "tomorig/processing/correlation/correlation_options.h"
+
+namespace tomorig::piv::detail {
+
+// Voxels whose magnitude exceeds `relative_threshold` times the volume's largest magnitude,
+// bucketed in blocks of `block` voxels per axis (scan order inside a block).
+struct OccupiedVoxels {
+  struct Entry {
+    std::uint16_t x, y, z;
+    float value;
+  };
+  Int3 block, blocks;                 // block size, block counts per axis
+  std::vector<std::size_t> offsets;   // blocks + 1 offsets into entries
+  std::vector<Entry> entries;
+  double occupied_fraction = 0;       // entries / voxels
+};
+// Fills `out`, reusing its memory (one list per volume for a whole correlation).
+void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, int threads, OccupiedVoxels& out);
+
+// The fraction of a volume's largest magnitude below which a voxel counts as empty.
+inline constexpr float kOccupiedThreshold = 1e-3f;
+
+class DirectCorrelator {
+ public:
+  DirectCorrelator(Int3 window, WindowWeighting weighting, double gaussian_sigma);
+
+  struct Scratch {
+    std::vector<float> a_weight;     // w(x) A(x) of the window's entries of a
+    std::vector<std::uint16_t> a_i, a_j, a_k;  // their window coordinates
+    StageSeconds seconds;
+  };
+
+  // The window of `va` (entries `oa`) at `start` against the window of `vb` (dense, read at
+  // the lags; entries `ob` for its sums) at the same start. `fallback` is false when the peak
+  // lies within the lags searched; otherwise the caller correlates this window by FFT.
+  WindowPeak correlate(const OccupiedVoxels& oa, const VolumeView& vb, const OccupiedVoxels& ob, Int3 start,
+                       Scratch& scratch, bool& fallback) const;
+
+ private:
+  Int3 window_;
+  std::vector<float> wx_, wy_, wz_;      // separable weights per axis
+  double weight_energy_ = 0;             // sum of w^2 over the window
+  // Circular autocorrelation of the weights per axis, K(d) for d = -2..2 at index d + 2.
+  double kx_[5], ky_[5], kz_[5];
+};
+
+}  // namespace tomorig::piv::detail
