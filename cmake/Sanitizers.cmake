@@ -1,6 +1,6 @@
 # TOMORIG_SANITIZE: a comma-separated list of GCC/Clang sanitizers (e.g. "address,undefined")
-# for every target of the tree. CI builds a second tree with it (scripts/setup.sh test) and runs
-# the library and CLI suites there; docs/reliability.md says which suites and why.
+# for every target of the tree. CI builds a second tree with it (scripts/setup.sh test runs
+# scripts/test-sanitized.sh); docs/reliability.md says which suites run there and why.
 set(TOMORIG_SANITIZE "" CACHE STRING "Sanitizers for every target, e.g. address,undefined (empty: none)")
 if(TOMORIG_SANITIZE)
   # -O1 keeps the instrumented suites fast enough for CI while the reports keep usable stacks;

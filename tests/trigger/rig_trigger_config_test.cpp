@@ -219,6 +219,7 @@ TEST(RigTriggerConfig, GpioWithAPulseGeneratorPlansMicrosecondDt) {
 }
 
 TEST(RigTriggerConfig, CliRefusesAConfiguredLimitNamingIt) {
+  if (!testing::tomorig_built()) GTEST_SKIP() << "tomorig binary not built: " << TOMORIG_BINARY;
   testing::TempDir dir;
   const auto path = dir / "led.toml";
   std::ofstream(path) << "[[cameras]]\nid = \"cam0\"\nbackend = \"simulated\"\n[cameras.roi]\nwidth = 64\nheight = 64\n"
