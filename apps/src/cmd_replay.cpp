@@ -17,6 +17,7 @@
 #include <zmq.hpp>
 
 #include "commands.h"
+#include "tomorig/core/console.h"
 #include "tomorig/rig/replay_schedule.h"
 #include "tomorig/rig/send_with_retry.h"
 #include "tomorig/rig/stop_signal.h"
@@ -63,27 +64,30 @@ struct ReplayOptions {
 
 double seconds_since(Clock::time_point t) { return duration<double>(Clock::now() - t).count(); }
 
-// One status line on stderr: rewritten in place on a terminal, one line per second in a log.
+// One status line on stderr (StatusLine: redrawn on a terminal, a line every few seconds in a log).
 class ReplayStatus {
  public:
-  ReplayStatus() : tty_(isatty(STDERR_FILENO) == 1), started_(Clock::now()), last_(started_) {}
+  ReplayStatus() : last_(Clock::now()) {}
 
   void update(const stream::SenderStats& s, std::uint64_t blocked_sets, bool final = false) {
+    if (!final && !line_.due()) return;
     const auto now = Clock::now();
-    if (!final && duration<double>(now - last_).count() < (tty_ ? 0.25 : 1.0)) return;
     const double dt = duration<double>(now - last_).count();
     const double rate = dt > 0 ? static_cast<double>(s.sets_sent - last_sets_) / dt : 0.0;
     const double mbps = dt > 0 ? static_cast<double>(s.bytes_sent - last_bytes_) / dt / 1e6 : 0.0;
-    fmt::print(stderr, "{}replay: {} sets sent  {:.1f} sets/s  {:.1f} MB/s  {} blocked sends{}", tty_ ? "\r" : "",
-               s.sets_sent, rate, mbps, blocked_sets, tty_ && !final ? "   " : "\n");
+    const std::string text = fmt::format("replay: {} sets sent  {:.1f} sets/s  {:.1f} MB/s  {} blocked sends",
+                                         s.sets_sent, rate, mbps, blocked_sets);
+    if (final) line_.finish(text);
+    else line_.update(text);
     last_ = now;
     last_sets_ = s.sets_sent;
     last_bytes_ = s.bytes_sent;
   }
+  void break_line() { line_.break_line(); }
 
  private:
-  bool tty_;
-  Clock::time_point started_, last_;
+  StatusLine line_;
+  Clock::time_point last_;
   std::uint64_t last_sets_ = 0, last_bytes_ = 0;
 };
 
@@ -167,6 +171,7 @@ void replay(const ReplayOptions& opt) {
     } catch (const Error& e) {
       if (!stopped) throw;
       // Stopped by the operator, typically after the recorder: nobody is left to tell.
+      status.break_line();
       fmt::print(stderr, "replay: {}\n", e.what());
     }
   }
