@@ -18,6 +18,7 @@
 #include <zmq.hpp>
 
 #include "commands.h"
+#include "json_summary.h"
 #include "tomorig/core/console.h"
 #include "tomorig/core/error.h"
 #include "tomorig/rig/recorder.h"
@@ -40,6 +41,7 @@ struct RecordArgs {
   std::optional<std::uint64_t> sets;
   std::string compression = "none";
   std::optional<double> idle_timeout_s;
+  JsonOutput json;
   rig::RecorderOptions recorder;  // out, overwrite and disk_reserve_mb bound directly
 };
 
@@ -244,11 +246,26 @@ void record(const RecordArgs& args) {
                          end->reason.empty() ? "" : " (" + end->reason + ")");
   else if (!stopped_by.empty())
     ending = "; stopped: " + stopped_by;
-  fmt::print("{}; {} lost sets, {} refused sets, {} rejected messages, {} session messages{}\n", done.brief(),
-             received.sets_missing, done.refused, rejected, received.session_messages, ending);
-  if (const auto refused = stream::refused_connections(); refused.count > 0)
-    fmt::print("{} connections refused for a wrong token (last from {})\n", refused.count, refused.last_peer);
-  fmt::print("next: tomorig inspect {}\n", done.out.string());
+  const auto refused_peers = stream::refused_connections();
+  if (!args.json.to_stdout()) {
+    fmt::print("{}; {} lost sets, {} refused sets, {} rejected messages, {} session messages{}\n", done.brief(),
+               received.sets_missing, done.refused, rejected, received.session_messages, ending);
+    if (refused_peers.count > 0)
+      fmt::print("{} connections refused for a wrong token (last from {})\n", refused_peers.count,
+                 refused_peers.last_peer);
+    fmt::print("next: tomorig inspect {}\n", done.out.string());
+  }
+  nlohmann::json j = json_summary("record");
+  j[json_key::kOut] = done.out.string();
+  j[json_key::kSets] = done.written;
+  j["bytes"] = done.bytes;
+  j["lost_sets"] = received.sets_missing;
+  j["refused_sets"] = done.refused;
+  j["rejected_messages"] = rejected;
+  j["refused_connections"] = refused_peers.count;
+  j["sender_outcome"] = end ? std::string(to_string(end->outcome)) : std::string();
+  j["stopped_by"] = stopped_by;
+  emit_json(args.json, j);
   if (end && end->sets_sent > received_sets)
     throw runtime_error(fmt::format("{} of the {} sets the sender sent never arrived; {} is complete with the {} that "
                                     "were recorded",
@@ -282,6 +299,7 @@ void add_record_command(CLI::App& root) {
   cmd->add_option("--max-set-mb", args->recorder.max_set_mb,
                   "Refuse a first set larger than this many MB of pixels (it would size the session)")
       ->capture_default_str();
+  add_json_flag(*cmd, args->json);
   cmd->callback([args] { record(*args); });
 }
 

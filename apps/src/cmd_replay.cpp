@@ -17,6 +17,7 @@
 #include <zmq.hpp>
 
 #include "commands.h"
+#include "json_summary.h"
 #include "tomorig/core/console.h"
 #include "tomorig/rig/replay_schedule.h"
 #include "tomorig/rig/send_with_retry.h"
@@ -49,6 +50,7 @@ using std::chrono::duration_cast;
 
 struct ReplayOptions {
   std::string file;
+  JsonOutput json;
   std::string to = "tcp://127.0.0.1:5555";
   bool connect = false;
   bool allow_remote = false;
@@ -193,8 +195,18 @@ void replay(const ReplayOptions& opt) {
     throw runtime_error(fmt::format("the receiver on {} stopped taking sets: sets still queued after {:g} s were "
                                     "lost ({} sets were handed to the transport)",
                                     endpoint, opt.timeout_s, sent.sets_sent));
-  fmt::print("replayed {} sets ({:.1f} MB) from {} on {}{}\n", sent.sets_sent, static_cast<double>(sent.bytes_sent) / 1e6,
-             opt.file, endpoint, stopped ? fmt::format(", stopped by {}", stop.signal_name()) : std::string());
+  if (!opt.json.to_stdout())
+    fmt::print("replayed {} sets ({:.1f} MB) from {} on {}{}\n", sent.sets_sent,
+               static_cast<double>(sent.bytes_sent) / 1e6, opt.file, endpoint,
+               stopped ? fmt::format(", stopped by {}", stop.signal_name()) : std::string());
+  nlohmann::json j = json_summary("replay");
+  j["session"] = opt.file;
+  j["endpoint"] = endpoint;
+  j[json_key::kSets] = sent.sets_sent;
+  j["bytes"] = sent.bytes_sent;
+  j["blocked_sends"] = blocked_sets;
+  j["stopped_by"] = stopped ? std::string(stop.signal_name()) : std::string();
+  emit_json(opt.json, j);
 }
 
 }  // namespace
@@ -223,6 +235,7 @@ void add_replay_command(CLI::App& root) {
                               "without a value {}",
                               stream::kDefaultPreviewEndpoint))
       ->expected(0, 1);
+  add_json_flag(*cmd, opt->json);
   cmd->callback([opt, cmd] {
     opt->preview_given = cmd->count("--preview") > 0;
     replay(*opt);

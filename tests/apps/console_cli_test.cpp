@@ -130,5 +130,16 @@ TEST_F(ConsoleCli, SimulateImportAndPreprocessSummariseAsJson) {
   EXPECT_EQ(pj["passes"], 2);
 }
 
+TEST_F(ConsoleCli, RunSummarisesAsJsonOnStdoutAlone) {
+  const fs::path out = *dir_ / "run.h5";
+  const CliResult r = run_tomorig("run --sets 2 --out " + shell_quoted(out.string()) + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["command"], "run");
+  EXPECT_EQ(j["out"], out.string());
+  EXPECT_EQ(j["sets"], 2);
+  EXPECT_EQ(j["frames_lost"], 0);
+}
+
 }  // namespace
 }  // namespace tomorig::testing
