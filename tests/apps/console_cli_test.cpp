@@ -141,5 +141,17 @@ TEST_F(ConsoleCli, RunSummarisesAsJsonOnStdoutAlone) {
   EXPECT_EQ(j["frames_lost"], 0);
 }
 
+// Issue 23: a window too deep for the grid was refused as "window.z = 64", the doubled first pass
+// of the multigrid, not the value the user gave.
+TEST_F(ConsoleCli, TooLargeWindowIsNamedAsTheUserWroteIt) {
+  const CliResult r = run_tomorig("process --session " + shell_quoted(session_) +
+                                  " --calib truth --grid 32,32,48,0.0195 --window 16,16,32 -o " +
+                                  shell_quoted((*dir_ / "w.h5").string()));
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--window 16,16,32: z = 32"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("use at most 24 along z"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(*dir_ / "w.h5"));
+}
+
 }  // namespace
 }  // namespace tomorig::testing
