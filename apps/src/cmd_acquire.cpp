@@ -20,6 +20,7 @@
 #include <zmq.hpp>
 
 #include "commands.h"
+#include "json_summary.h"
 #include "tomorig/rig/record_layout.h"
 #include "tomorig/rig/rig_acquisition.h"
 #include "tomorig/rig/rig_run_options.h"
@@ -61,6 +62,7 @@ constexpr std::chrono::milliseconds kSendSlice{50};
 
 struct AcquireOptions {
   RigRunChoices rig;
+  JsonOutput json;
   std::string to = "tcp://127.0.0.1:5555";
   bool connect = false;
   bool allow_remote = false;
@@ -195,9 +197,19 @@ void acquire(const AcquireOptions& opt) {
   sender.reset();
   figures.state = rig_run.failure().empty() ? "stopped" : "failed";
   refresh(true);
-  fmt::print("acquired and sent {} sets ({:.1f} MB) on {}; {} lost frames, {} incomplete sets{}\n", sent.sets_sent,
-             static_cast<double>(sent.bytes_sent) / 1e6, endpoint, losses.frames_lost(), losses.incomplete_sets(),
-             stopped_by.empty() ? "" : fmt::format(", stopped by {}", stopped_by));
+  if (!opt.json.to_stdout())
+    fmt::print("acquired and sent {} sets ({:.1f} MB) on {}; {} lost frames, {} incomplete sets{}\n", sent.sets_sent,
+               static_cast<double>(sent.bytes_sent) / 1e6, endpoint, losses.frames_lost(), losses.incomplete_sets(),
+               stopped_by.empty() ? "" : fmt::format(", stopped by {}", stopped_by));
+  nlohmann::json j = json_summary("acquire");
+  j["endpoint"] = endpoint;
+  j[json_key::kSets] = sent.sets_sent;
+  j["bytes"] = sent.bytes_sent;
+  j["frames_lost"] = losses.frames_lost();
+  j["incomplete_sets"] = losses.incomplete_sets();
+  j["stopped_by"] = stopped_by;
+  j["failure"] = rig_run.failure();
+  emit_json(opt.json, j);
   if (!rig_run.failure().empty()) throw runtime_error(rig_run.failure());
 }
 
@@ -217,6 +229,7 @@ void add_acquire_command(CLI::App& root) {
   cmd->add_option("--wait", opt->wait_s, "Seconds to wait for a recorder to take the session start (the trigger "
                                         "starts after it)")
       ->capture_default_str();
+  add_json_flag(*cmd, opt->json);
   cmd->callback([opt] { acquire(*opt); });
 }
 

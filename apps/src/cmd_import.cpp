@@ -9,6 +9,7 @@
 #include <fmt/core.h>
 
 #include "commands.h"
+#include "json_summary.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
 #include "tomorig/storage/image_import.h"
@@ -19,6 +20,7 @@ namespace {
 struct ImportArgs {
   std::vector<std::string> cameras;  // "ID=PATTERN"
   std::string pairing = "auto";
+  JsonOutput json;
   double dt_us = 0.0;
   double pixel_pitch_um = 0.0;
   double rate_hz = 0.0;
@@ -80,6 +82,23 @@ void run_import(const ImportArgs& args) {
   }
 
   const storage::ImportResult result = storage::import_images(o, args.out);
+  nlohmann::json j = json_summary("import");
+  j[json_key::kOut] = result.output.string();
+  j[json_key::kSets] = result.sets;
+  j["pairing"] = std::string(to_string(result.plan.pairing));
+  j["compression"] = std::string(to_string(o.writer.compression));
+  j["dt_us"] = o.dt_us;
+  j[json_key::kCameras] = nlohmann::json::array();
+  for (std::size_t c = 0; c < result.cameras.size(); ++c)
+    j[json_key::kCameras].push_back({{"id", result.cameras[c].id},
+                                     {"width", result.cameras[c].width},
+                                     {"height", result.cameras[c].height},
+                                     {"pixel_format", std::string(to_string(result.cameras[c].pixel_format))},
+                                     {"files", result.plan.cameras[c].files.size()}});
+  if (args.json.to_stdout()) {
+    emit_json(args.json, j);
+    return;
+  }
   fmt::print("imported {} set{} from {} camera{} into {} (frames paired by {}, compression {})\n", result.sets,
              result.sets == 1 ? "" : "s", result.cameras.size(), result.cameras.size() == 1 ? "" : "s",
              result.output.string(), to_string(result.plan.pairing), to_string(o.writer.compression));
@@ -93,6 +112,7 @@ void run_import(const ImportArgs& args) {
   fmt::print("dt {:g} us, pixel pitch {}\n", o.dt_us,
              o.cameras.front().pixel_pitch_um > 0 ? fmt::format("{:g} um", o.cameras.front().pixel_pitch_um)
                                                   : std::string("unknown"));
+  emit_json(args.json, j);
 }
 
 }  // namespace
@@ -121,6 +141,7 @@ void add_import_command(CLI::App& root) {
       ->capture_default_str();
   cmd->add_flag("--overwrite", args->overwrite, "Replace the output file if it exists");
   cmd->add_option("--out,-o", args->out, "Output session file (.h5)")->required();
+  add_json_flag(*cmd, args->json);
   cmd->callback([args] { run_import(*args); });
 }
 

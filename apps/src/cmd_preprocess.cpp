@@ -16,7 +16,9 @@
 #include <fmt/core.h>
 
 #include "commands.h"
+#include "json_summary.h"
 #include "tomorig/pipeline/session_preprocessor.h"
+#include "tomorig/core/console.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/preprocess/chain_spec.h"
 #include "tomorig/processing/preprocess/image_chain.h"
@@ -39,6 +41,7 @@ struct PreprocessArgs {
   std::string out;
   std::string sets;
   bool overwrite = false;
+  JsonOutput json;
 };
 
 struct SetRange {
@@ -93,9 +96,10 @@ void run(const PreprocessArgs& args) {
     if (preprocess::needs_sequence_image(spec.steps[i])) sequence_steps.push_back(i);
   const std::size_t passes = sequence_steps.size() + 1;
   const std::uint64_t set_total = range.end - range.first;
+  StatusLine status;
   const auto progress = [&](std::size_t pass, std::uint64_t done) {
-    fmt::print(stderr, "\rpreprocess: pass {}/{}, set {}/{}", pass + 1, passes, done, set_total);
-    if (done == set_total) fmt::print(stderr, "\n");
+    if (done == set_total) status.finish(fmt::format("preprocess: pass {}/{}, set {}/{}", pass + 1, passes, done, set_total));
+    else if (status.due()) status.update(fmt::format("preprocess: pass {}/{}, set {}/{}", pass + 1, passes, done, set_total));
   };
 
   // Streaming passes: the chain up to each sequence step, folded into a minimum or an average.
@@ -152,7 +156,16 @@ void run(const PreprocessArgs& args) {
     progress(passes - 1, s - range.first + 1);
   }
   writer.finish();
-  fmt::print("wrote {} sets of {} cameras to {} ({} steps)\n", set_total, cameras.size(), args.out, spec.steps.size());
+  if (!args.json.to_stdout())
+    fmt::print("wrote {} sets of {} cameras to {} ({} steps)\n", set_total, cameras.size(), args.out, spec.steps.size());
+  nlohmann::json j = json_summary("preprocess");
+  j[json_key::kOut] = args.out;
+  j[json_key::kSets] = set_total;
+  j[json_key::kCameras] = cameras.size();
+  j["first_set"] = range.first;
+  j["steps"] = spec.steps.size();
+  j["passes"] = passes;
+  emit_json(args.json, j);
 }
 
 }  // namespace
@@ -167,6 +180,7 @@ void add_preprocess_command(CLI::App& root) {
   cmd->add_option("-o,--out", args->out, "Preprocessed session to write (.h5)")->required();
   cmd->add_option("--sets", args->sets, "Sets A:B (A to B-1, 0-based) or A: (to the end); default all");
   cmd->add_flag("--overwrite", args->overwrite, "Replace an existing output file");
+  add_json_flag(*cmd, args->json);
   cmd->callback([args] { run(*args); });
 }
 

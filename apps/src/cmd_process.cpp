@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
+#include <spdlog/spdlog.h>
 
 #include "commands.h"
 #include "process_progress.h"
@@ -34,25 +35,29 @@ void run(const ProcessArgs& args) {
   std::unique_ptr<ProgressLine> progress;
   pipeline::BackendHooks hooks;
   hooks.should_stop = [&] { return stop_signal.stop_requested(); };
-  hooks.notice = [](const std::string& text) { fmt::print(stderr, "{}\n", text); };
+  hooks.notice = [&](const std::string& text) {
+    if (progress) progress->break_line();
+    spdlog::info("{}", text);
+  };
   hooks.started = [&](std::uint64_t sets_to_do) { progress = std::make_unique<ProgressLine>(sets_to_do); };
   hooks.set_done = [&](const pipeline::BackendSetDone& s) {
     const std::string by =
         s.rank < 0 ? std::string()
                    : fmt::format(" on rank {} (its {} sets, {:.3g} sets/s)", s.rank, s.rank_sets, s.rank_sets_per_second);
-    fmt::print(stderr, "\rset {} done{}: {} vectors, {:.1f} % valid, {:.1f} s\n", s.index, by, s.vectors,
-               100.0 * s.valid_fraction, s.seconds);
+    if (progress) progress->break_line();
+    spdlog::info("set {} done{}: {} vectors, {:.1f} % valid, {:.1f} s", s.index, by, s.vectors,
+                 100.0 * s.valid_fraction, s.seconds);
     if (progress) progress->set_done();
   };
   pipeline::BackendReport report;
   try {
     report = pipeline::run_backend(args.session, options, hooks);
   } catch (...) {
-    if (progress && progress->mid_line()) fmt::print(stderr, "\n");  // the error on a line of its own
+    if (progress) progress->break_line();  // the error on a line of its own
     throw;
   }
   if (report.worker_rank) return;  // an MPI rank other than 0: rank 0 reports the run
-  if (report.interrupted && progress && progress->mid_line()) fmt::print(stderr, "\n");
+  if (progress) progress->break_line();
   if (report.interrupted)
     throw runtime_error(fmt::format("interrupted by {}: '{}' is valid and holds {} of {} sets; run the same command "
                                     "again to resume",

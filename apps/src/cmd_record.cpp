@@ -14,9 +14,12 @@
 #include <variant>
 
 #include <fmt/core.h>
+#include <spdlog/spdlog.h>
 #include <zmq.hpp>
 
 #include "commands.h"
+#include "json_summary.h"
+#include "tomorig/core/console.h"
 #include "tomorig/core/error.h"
 #include "tomorig/rig/recorder.h"
 #include "tomorig/rig/stop_signal.h"
@@ -38,7 +41,7 @@ struct RecordArgs {
   std::optional<std::uint64_t> sets;
   std::string compression = "none";
   std::optional<double> idle_timeout_s;
-  bool verbose = false;
+  JsonOutput json;
   rig::RecorderOptions recorder;  // out, overwrite and disk_reserve_mb bound directly
 };
 
@@ -49,34 +52,31 @@ constexpr std::chrono::milliseconds kReceivePoll{250};
 // flood the terminal.
 constexpr std::uint64_t kPrintedRefusals = 10;
 
-// "record: 12 sets  41.9 MB/s to disk  0 lost sets  0 refused  0 rejected", rewritten in place
-// on a terminal, at most 4 times a second (once a second otherwise).
+// "record: 12 sets  41.9 MB/s to disk  0 lost sets  0 refused  0 rejected" on a StatusLine:
+// redrawn on a terminal, a plain line every few seconds into a log.
 class RecordStatus {
  public:
-  RecordStatus() : tty_(isatty(STDERR_FILENO) == 1), last_(Clock::now()) {}
+  RecordStatus() : last_(Clock::now()) {}
 
   void update(const rig::RecorderReport& c, std::uint64_t rejected, const stream::ReceiverStats& r,
               bool final = false) {
+    if (!final && !line_.due()) return;
     const auto now = Clock::now();
     const double dt = duration<double>(now - last_).count();
-    if (!final && dt < (tty_ ? 0.25 : 1.0)) return;
     const double mbps = dt > 0 ? static_cast<double>(c.bytes - last_bytes_) / dt / 1e6 : 0.0;
     // ZeroMQ does not expose its queue, so the status shows what the recorder can count.
-    fmt::print(stderr, "{}record: {} sets  {:.1f} MB/s to disk  {} lost sets  {} refused  {} rejected{}",
-               tty_ ? "\r" : "", c.written, mbps, r.sets_missing, c.refused, rejected, tty_ && !final ? "   " : "\n");
+    const std::string text = fmt::format("record: {} sets  {:.1f} MB/s to disk  {} lost sets  {} refused  {} rejected",
+                                         c.written, mbps, r.sets_missing, c.refused, rejected);
+    if (final) line_.finish(text);
+    else line_.update(text);
     last_ = now;
     last_bytes_ = c.bytes;
-    line_open_ = tty_ && !final;
   }
   // Ends a line rewritten in place, so another message starts on a fresh line.
-  void break_line() {
-    if (line_open_) fmt::print(stderr, "\n");
-    line_open_ = false;
-  }
+  void break_line() { line_.break_line(); }
 
  private:
-  bool tty_;
-  bool line_open_ = false;
+  StatusLine line_;
   Clock::time_point last_;
   std::uint64_t last_bytes_ = 0;
 };
@@ -220,9 +220,11 @@ void record(const RecordArgs& args) {
       throw runtime_error(fmt::format("recording stopped: {}; {} is complete with {} sets", why,
                                       options.out.string(), recorder->report().written));
     }
-    if (args.verbose)
-      fmt::print(stderr, "record: wrote set {} (trigger {}) as set {}\n", set.set_index, set.trigger_index,
-                 recorder->report().written - 1);
+    if (verbosity() == Verbosity::verbose) {
+      status.break_line();
+      spdlog::debug("record: wrote set {} (trigger {}) as set {}", set.set_index, set.trigger_index,
+                    recorder->report().written - 1);
+    }
     update(false);
   }
   update(true);
@@ -244,11 +246,26 @@ void record(const RecordArgs& args) {
                          end->reason.empty() ? "" : " (" + end->reason + ")");
   else if (!stopped_by.empty())
     ending = "; stopped: " + stopped_by;
-  fmt::print("{}; {} lost sets, {} refused sets, {} rejected messages, {} session messages{}\n", done.brief(),
-             received.sets_missing, done.refused, rejected, received.session_messages, ending);
-  if (const auto refused = stream::refused_connections(); refused.count > 0)
-    fmt::print("{} connections refused for a wrong token (last from {})\n", refused.count, refused.last_peer);
-  fmt::print("next: tomorig inspect {}\n", done.out.string());
+  const auto refused_peers = stream::refused_connections();
+  if (!args.json.to_stdout()) {
+    fmt::print("{}; {} lost sets, {} refused sets, {} rejected messages, {} session messages{}\n", done.brief(),
+               received.sets_missing, done.refused, rejected, received.session_messages, ending);
+    if (refused_peers.count > 0)
+      fmt::print("{} connections refused for a wrong token (last from {})\n", refused_peers.count,
+                 refused_peers.last_peer);
+    fmt::print("next: tomorig inspect {}\n", done.out.string());
+  }
+  nlohmann::json j = json_summary("record");
+  j[json_key::kOut] = done.out.string();
+  j[json_key::kSets] = done.written;
+  j["bytes"] = done.bytes;
+  j["lost_sets"] = received.sets_missing;
+  j["refused_sets"] = done.refused;
+  j["rejected_messages"] = rejected;
+  j["refused_connections"] = refused_peers.count;
+  j["sender_outcome"] = end ? std::string(to_string(end->outcome)) : std::string();
+  j["stopped_by"] = stopped_by;
+  emit_json(args.json, j);
   if (end && end->sets_sent > received_sets)
     throw runtime_error(fmt::format("{} of the {} sets the sender sent never arrived; {} is complete with the {} that "
                                     "were recorded",
@@ -282,7 +299,7 @@ void add_record_command(CLI::App& root) {
   cmd->add_option("--max-set-mb", args->recorder.max_set_mb,
                   "Refuse a first set larger than this many MB of pixels (it would size the session)")
       ->capture_default_str();
-  cmd->add_flag("-v,--verbose", args->verbose, "Print a line for every set written");
+  add_json_flag(*cmd, args->json);
   cmd->callback([args] { record(*args); });
 }
 

@@ -18,6 +18,8 @@
 
 #include "commands.h"
 #include "http_options.h"
+#include "json_summary.h"
+#include "tomorig/core/console.h"
 #include "tomorig/rig/replay_schedule.h"
 #include "tomorig/rig/send_with_retry.h"
 #include "tomorig/rig/stop_signal.h"
@@ -51,6 +53,7 @@ using std::chrono::duration_cast;
 
 struct ReplayOptions {
   std::string file;
+  JsonOutput json;
   std::string to = "tcp://127.0.0.1:5555";
   bool connect = false;
   bool allow_remote = false;
@@ -68,27 +71,30 @@ struct ReplayOptions {
 
 double seconds_since(Clock::time_point t) { return duration<double>(Clock::now() - t).count(); }
 
-// One status line on stderr: rewritten in place on a terminal, one line per second in a log.
+// One status line on stderr (StatusLine: redrawn on a terminal, a line every few seconds in a log).
 class ReplayStatus {
  public:
-  ReplayStatus() : tty_(isatty(STDERR_FILENO) == 1), started_(Clock::now()), last_(started_) {}
+  ReplayStatus() : last_(Clock::now()) {}
 
   void update(const stream::SenderStats& s, std::uint64_t blocked_sets, bool final = false) {
+    if (!final && !line_.due()) return;
     const auto now = Clock::now();
-    if (!final && duration<double>(now - last_).count() < (tty_ ? 0.25 : 1.0)) return;
     const double dt = duration<double>(now - last_).count();
     const double rate = dt > 0 ? static_cast<double>(s.sets_sent - last_sets_) / dt : 0.0;
     const double mbps = dt > 0 ? static_cast<double>(s.bytes_sent - last_bytes_) / dt / 1e6 : 0.0;
-    fmt::print(stderr, "{}replay: {} sets sent  {:.1f} sets/s  {:.1f} MB/s  {} blocked sends{}", tty_ ? "\r" : "",
-               s.sets_sent, rate, mbps, blocked_sets, tty_ && !final ? "   " : "\n");
+    const std::string text = fmt::format("replay: {} sets sent  {:.1f} sets/s  {:.1f} MB/s  {} blocked sends",
+                                         s.sets_sent, rate, mbps, blocked_sets);
+    if (final) line_.finish(text);
+    else line_.update(text);
     last_ = now;
     last_sets_ = s.sets_sent;
     last_bytes_ = s.bytes_sent;
   }
+  void break_line() { line_.break_line(); }
 
  private:
-  bool tty_;
-  Clock::time_point started_, last_;
+  StatusLine line_;
+  Clock::time_point last_;
   std::uint64_t last_sets_ = 0, last_bytes_ = 0;
 };
 
@@ -186,6 +192,7 @@ void replay(const ReplayOptions& opt) {
     } catch (const Error& e) {
       if (!stopped) throw;
       // Stopped by the operator, typically after the recorder: nobody is left to tell.
+      status.break_line();
       fmt::print(stderr, "replay: {}\n", e.what());
     }
   }
@@ -207,8 +214,18 @@ void replay(const ReplayOptions& opt) {
     throw runtime_error(fmt::format("the receiver on {} stopped taking sets: sets still queued after {:g} s were "
                                     "lost ({} sets were handed to the transport)",
                                     endpoint, opt.timeout_s, sent.sets_sent));
-  fmt::print("replayed {} sets ({:.1f} MB) from {} on {}{}\n", sent.sets_sent, static_cast<double>(sent.bytes_sent) / 1e6,
-             opt.file, endpoint, stopped ? fmt::format(", stopped by {}", stop.signal_name()) : std::string());
+  if (!opt.json.to_stdout())
+    fmt::print("replayed {} sets ({:.1f} MB) from {} on {}{}\n", sent.sets_sent,
+               static_cast<double>(sent.bytes_sent) / 1e6, opt.file, endpoint,
+               stopped ? fmt::format(", stopped by {}", stop.signal_name()) : std::string());
+  nlohmann::json j = json_summary("replay");
+  j["session"] = opt.file;
+  j["endpoint"] = endpoint;
+  j[json_key::kSets] = sent.sets_sent;
+  j["bytes"] = sent.bytes_sent;
+  j["blocked_sends"] = blocked_sets;
+  j["stopped_by"] = stopped ? std::string(stop.signal_name()) : std::string();
+  emit_json(opt.json, j);
 }
 
 }  // namespace
@@ -238,6 +255,7 @@ void add_replay_command(CLI::App& root) {
                               stream::kDefaultPreviewEndpoint))
       ->expected(0, 1);
   add_http_options(*cmd, opt->http);
+  add_json_flag(*cmd, opt->json);
   cmd->callback([opt, cmd] {
     opt->preview_given = cmd->count("--preview") > 0;
     opt->http_given = opt->http.given(*cmd);

@@ -10,6 +10,7 @@
 #include <fmt/core.h>
 
 #include "commands.h"
+#include "json_summary.h"
 #include "http_options.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
@@ -30,6 +31,7 @@ struct RunArgs {
   std::string compression = "none";
   rig::RecorderOptions recorder;  // overwrite and disk_reserve_mb bound directly
   std::vector<std::string> stages;
+  JsonOutput json;
   std::vector<std::string> preview;  // --preview [ENDPOINT]: given with or without a value
   bool preview_given = false;
   HttpChoices http;  // --http: the dashboard, fed by the run's quick-look and status streams
@@ -64,7 +66,8 @@ void run(const RunArgs& args) {
 
   // Builds, configures and arms everything: a bad rig or output fails here, before a file exists.
   rig::RigRunner runner(rig, options);
-  fmt::print("tomorig run: rig '{}', {} cameras, {}{}\n", rig.name, rig.cameras.size(),
+  // With --json on stdout the header goes to stderr, so that stdout is the JSON object alone.
+  fmt::print(args.json.to_stdout() ? stderr : stdout, "tomorig run: rig '{}', {} cameras, {}{}\n", rig.name, rig.cameras.size(),
              rig::run_length_text(options.acquisition),
              rig.simulation ? fmt::format(", case {} at {} ppp", rig.simulation->case_name, rig.simulation->ppp)
                             : std::string());
@@ -90,7 +93,18 @@ void run(const RunArgs& args) {
   const rig::StopSignalGuard stop;
   const rig::RigRunReport report = runner.run([&](const rig::RecorderReport&) { return stop.stop_requested(); });
   const std::string out = report.recording.out.string();
-  fmt::print("{}\nnext: tomorig inspect {}\n", report.brief(), out);
+  if (!args.json.to_stdout()) fmt::print("{}\nnext: tomorig inspect {}\n", report.brief(), out);
+  nlohmann::json j = json_summary("run");
+  j[json_key::kOut] = out;
+  j[json_key::kSets] = report.recording.written;
+  j[json_key::kCameras] = report.cameras;
+  j[json_key::kSeconds] = report.seconds;
+  j["frames_lost"] = report.frames_lost;
+  j["incomplete_sets"] = report.incomplete_sets;
+  j["stopped"] = report.stopped;
+  j["failure"] = report.failure;
+  j["bytes"] = report.file_bytes;
+  emit_json(args.json, j);
   for (const pipeline::StageReport& stage : report.stages) {
     fmt::print(stderr, "run: stage {}\n", stage.brief());
     if (const std::string text = pipeline::quicklook_report_text(stage); !text.empty()) fmt::print(stderr, "run: {}\n", text);
@@ -138,6 +152,7 @@ void add_run_command(CLI::App& root) {
                               stream::kDefaultPreviewEndpoint))
       ->expected(0, 1);
   add_http_options(*cmd, args->http);
+  add_json_flag(*cmd, args->json);
   cmd->callback([args, cmd] {
     args->preview_given = cmd->count("--preview") > 0;
     args->http_given = args->http.given(*cmd);

@@ -11,6 +11,8 @@
 #include <fmt/core.h>
 
 #include "commands.h"
+#include "json_summary.h"
+#include "tomorig/core/console.h"
 #include "tomorig/rig/simulate_calib_target.h"
 #include "tomorig/rig/simulate_session.h"
 #include "tomorig/rig/simulate_spray.h"
@@ -51,6 +53,7 @@ struct SimulateFlags {
   CLI::Option* bit_depth_opt = nullptr;
   CLI::Option* distortion_opt = nullptr;
   CLI::Option* spray_opt = nullptr;
+  JsonOutput json;
 };
 
 // calib-thesis is a target case, not a particle case: it has its own renderer and writes one
@@ -64,7 +67,12 @@ void run_calib_thesis(const SimulateFlags& f, storage::Compression compression) 
   o.reduced = f.reduced;
   if (f.seed_opt->count()) o.seed = f.seed;
   o.distortion_corner_px = f.distortion_px;
-  fmt::print("{}\n", write_calib_target_session(o, f.out, compression, f.overwrite));
+  const std::string written = write_calib_target_session(o, f.out, compression, f.overwrite);
+  if (!f.json.to_stdout()) fmt::print("{}\n", written);
+  nlohmann::json j = json_summary("simulate");
+  j[json_key::kOut] = f.out;
+  j["case"] = "calib-thesis";
+  emit_json(f.json, j);
 }
 
 // spray-thesis is a shadowgraphy case with its own renderer (spray.h, simulate_spray.h):
@@ -77,16 +85,22 @@ void run_spray_thesis(const SimulateFlags& f, storage::Compression compression) 
   o.reduced = f.reduced;
   if (f.seed_opt->count()) o.seed = f.seed;
   o.pattern = sim::parse_spray_pattern(f.spray);
+  std::string written;
   if (f.targets) {
     if (f.sets_opt->count()) throw bad_input("--targets renders one set per PSF depth (13): --sets does not apply");
-    fmt::print("{}\n", rig::write_spray_target_session(o, f.out, compression, f.overwrite));
-    return;
+    written = rig::write_spray_target_session(o, f.out, compression, f.overwrite);
+  } else {
+    const int sets = f.sets_opt->count() ? f.sets : 2;
+    written = rig::write_spray_session(o, sets, f.out, compression, f.overwrite, [](int done, int total) {
+      fmt::print(stderr, "set {}/{} rendered\n", done, total);
+      std::fflush(stderr);
+    });
   }
-  const int sets = f.sets_opt->count() ? f.sets : 2;
-  fmt::print("{}\n", rig::write_spray_session(o, sets, f.out, compression, f.overwrite, [](int done, int total) {
-               fmt::print(stderr, "set {}/{} rendered\n", done, total);
-               std::fflush(stderr);
-             }));
+  if (!f.json.to_stdout()) fmt::print("{}\n", written);
+  nlohmann::json j = json_summary("simulate");
+  j[json_key::kOut] = f.out;
+  j["case"] = f.targets ? "spray-thesis targets" : "spray-thesis";
+  emit_json(f.json, j);
 }
 
 void run_simulate(const SimulateFlags& f) {
@@ -149,12 +163,23 @@ void run_simulate(const SimulateFlags& f) {
     for (const std::string& o : overrides) rig.source_text += "#   " + o + "\n";
   }
 
+  StatusLine status;
   const SimulationSummary summary = run_simulation_to_session(
-      rig, f.out, *compression, f.overwrite, [](std::uint64_t done, std::uint64_t total, double seconds) {
-        fmt::print(stderr, "set {}/{} rendered ({:.2f} s)\n", done, total, seconds);
-        std::fflush(stderr);
+      rig, f.out, *compression, f.overwrite, [&](std::uint64_t done, std::uint64_t total, double seconds) {
+        const auto text = [&] { return fmt::format("simulate: set {}/{} rendered ({:.2f} s)", done, total, seconds); };
+        if (done == total) status.finish(text());
+        else if (status.due()) status.update(text());
       });
-  fmt::print("{}\n", summary.brief());
+  if (!f.json.to_stdout()) fmt::print("{}\n", summary.brief());
+  nlohmann::json j = json_summary("simulate");
+  j[json_key::kOut] = summary.output.string();
+  j[json_key::kSets] = summary.sets;
+  j[json_key::kCameras] = summary.cameras;
+  j[json_key::kSeconds] = summary.seconds;
+  j["case"] = summary.case_name;
+  j["particles_per_set"] = summary.particles_per_set;
+  j["bytes"] = summary.bytes;
+  emit_json(f.json, j);
 }
 
 }  // namespace
@@ -182,6 +207,7 @@ void add_simulate_command(CLI::App& root) {
                 "spray-thesis: the knife-edge calibration series (one set per PSF depth) instead of droplets");
   flags->distortion_opt = cmd->add_option("--distortion-px", flags->distortion_px,
                                           "calib-thesis: radial lens distortion at the image corner, full-size px");
+  add_json_flag(*cmd, flags->json);
   cmd->callback([flags] { run_simulate(*flags); });
 }
 

@@ -7,6 +7,7 @@
 #include <fmt/core.h>
 
 #include "commands.h"
+#include "console_flags.h"
 #include "exit_codes.h"
 #include "tomorig/bench/bench_command.h"
 #include "tomorig/core/error.h"
@@ -38,6 +39,7 @@ int main(int argc, char** argv) {
   add_optics_command(app);
   tomorig::bench::add_bench_command(app);
   add_trigger_command(app);
+  add_console_flags(app);  // after every command: each gets --quiet and --verbose
 
   try {
     app.parse(argc, argv);

@@ -36,8 +36,8 @@ std::string ProgressLine::text() const {
 
 void ProgressLine::set_done() {
   ++done_;
-  fmt::print(stderr, "\r{}{}", text(), done_ == total_ ? "\n" : "");
-  std::fflush(stderr);
+  if (done_ >= total_) line_.finish(text());
+  else if (line_.due()) line_.update(text());
 }
 
 }  // namespace tomorig::app

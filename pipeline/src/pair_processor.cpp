@@ -1,8 +1,11 @@
 #include "pair_processor.h"
 
+#include <tuple>
+
 #include <fmt/core.h>
 
 #include "tomorig/core/error.h"
+#include "tomorig/pipeline/correlation_args.h"
 #include "tomorig/pipeline/report_json.h"
 #include "tomorig/processing/reconstruction/smoothing.h"
 
@@ -26,6 +29,15 @@ piv::CorrelationOptions correlation_for(const BackendOptions& options, const Vox
   CorrelationArgs args = options.correlation;
   args.threads = options.threads;
   const piv::CorrelationOptions corr = correlation_options(args);
+  // The multigrid starts at twice --window on volumes binned 2x: a window more than half the grid
+  // is refused here in the user's own terms, not as the doubled first pass (issue 23).
+  const piv::WindowSize w = parse_window(args.window);
+  for (const auto& [axis, size, voxels] : {std::tuple{'x', w.x, grid.nx}, std::tuple{'y', w.y, grid.ny},
+                                           std::tuple{'z', w.z, grid.nz}})
+    if (2 * size > voxels)
+      throw bad_input(fmt::format("--window {}: {} = {} is larger than the volume allows ({} voxels along {}; the "
+                                  "multigrid's first pass is twice the window, {} voxels); use at most {} along {}",
+                                  args.window, axis, size, voxels, axis, 2 * size, voxels / 2, axis));
   corr.validate(grid);  // an interrogation volume larger than the grid fails here, before any work
   return corr;
 }

@@ -1,5 +1,6 @@
 #include "tomorig/pipeline/session_geometry.h"
 
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <sstream>
@@ -163,7 +164,14 @@ VoxelGrid parse_grid(const std::string& text) {
 
 void add_reconstruction_flags(CLI::App& cmd, ReconstructionChoices& choices, const std::string& algorithm_default) {
   cmd.add_option("--algorithm", choices.algorithm,
-                 "Reconstruction algorithm: " + recon::algorithm_names() + " (default: " + algorithm_default + ")");
+                 "Reconstruction algorithm: " + recon::algorithm_names() + ", any case (default: " + algorithm_default +
+                     ")")
+      ->transform(CLI::Validator(  // "FMART" as well as "fmart" (issue 23)
+          [](std::string& name) {
+            for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+            return std::string();
+          },
+          "", "lower case"));
   cmd.add_option("--iterations", choices.iterations,
                  fmt::format("Iterations of MART/SMART/FMART (default: the rig config's, else {})",
                              choices.options.max_iterations));

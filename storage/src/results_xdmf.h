@@ -1,6 +1,6 @@
 #pragma once
 // XDMF 3 text for a results file: one uniform grid per set (displacement, velocity, status,
-// peak) and one for the ensemble statistics, all node-centred on the interrogation grid.
+// peak, and the ensemble statistics beside them), all node-centred on the interrogation grid.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -14,13 +14,8 @@ struct XdmfFieldGrid {
   Vec3d origin, spacing;  // mm
 };
 
-// Format version 1. `file_name`: the HDF5 file's name relative to the .xdmf; `sets`: the set
-// names under /sets.
-std::string xdmf_for_results(const std::string& file_name, const XdmfFieldGrid& grid,
-                             const std::vector<std::string>& sets, bool has_statistics);
-
-// Format version 2: each set is a row of the /sets datasets (`rows` long), selected by an XDMF
-// hyperslab.
+// Format version 2: each set is a row of the /sets datasets (`rows` long). `file_name`: the
+// HDF5 file's name relative to the .xdmf.
 struct XdmfSetRow {
   std::uint64_t set_index = 0;
   std::uint64_t row = 0;

@@ -87,6 +87,10 @@ TEST(ResultsFile, RoundTripsFieldsFlagsPeaksAndNodePositions) {
   EXPECT_NE(xdmf.find("r.h5:/sets/velocity_m_s"), std::string::npos);
   EXPECT_NE(xdmf.find("r.h5:/statistics/mean_velocity_m_s"), std::string::npos);
   EXPECT_NE(xdmf.find("Dimensions=\"2 3 4 3\""), std::string::npos);
+  // Issue 23: Xdmf3 (ParaView's Xdmf3ReaderS/T) loads ItemType="HyperSlab" items as empty arrays;
+  // it reads the row from the HDF5 path's hyperslab suffix (start:stride:count:dataspace) instead.
+  EXPECT_EQ(xdmf.find("ItemType=\"HyperSlab\""), std::string::npos) << xdmf;
+  EXPECT_NE(xdmf.find("r.h5:/sets/velocity_m_s|1 0 0 0 0:1 1 1 1 1:1 2 3 4 3:2 2 3 4 3\n"), std::string::npos) << xdmf;
 }
 
 // Issue 23: `nodes` was float64, so numpy's reshape(nz, ny, nx, 3) with it raised a TypeError.

@@ -10,6 +10,11 @@
 
 namespace tomorig::bench {
 
+// The Gaussian smoothing (sigma x,y,z in voxels) the bench commands apply to reconstructed volumes
+// before judging them: the sigma that maximises Q for tomorig's volumes at sigma_w 0.6 px
+// (docs/accuracy.md, "Smoothing"; the thesis's 0.68,0.68,0.1 is --fmart-smoothing 0.68,0.68,0.1).
+inline constexpr const char* kJudgingSmoothingVoxel = "0.6,0.6,0.5";
+
 // {"cpu": ..., "cores": ..., "memory_gb": ..., "software_version": ..., "hostname": ...}
 nlohmann::json machine_json();
 

@@ -50,7 +50,7 @@ struct BenchPiv3dArgs {
   double relaxation = 0.0;  // 0: the library default
   BenchReconTuning tuning;  // --sigma-px, --prune
   double mlos_threshold = -1.0;  // < 0: the library default
-  std::string fmart_smoothing = "0.68,0.68,0.1";
+  std::string fmart_smoothing = kJudgingSmoothingVoxel;
   std::uint64_t seed = 1;
   int threads = 0;
   std::string json_out;

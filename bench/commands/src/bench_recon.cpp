@@ -56,7 +56,7 @@ struct BenchReconArgs {
   std::string json_out;
   // Post-smoothing of FMART volumes before judging them, as the thesis did (Sect. 3.2.2);
   // "0" turns it off. Both the smoothed and the raw figures are reported.
-  std::string fmart_smoothing = "0.68,0.68,0.1";
+  std::string fmart_smoothing = kJudgingSmoothingVoxel;
   std::string session;  // a recorded session instead of a simulated case (no truth)
   std::string calib;
   std::size_t set = 0;

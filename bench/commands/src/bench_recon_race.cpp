@@ -41,7 +41,7 @@ struct RaceArgs {
   double mlos_threshold = recon::ReconstructionOptions{}.mlos_threshold;  // the library's default
   BenchReconTuning tuning;       // --sigma-px, --prune
   double q_target = 0.0;         // 0: the lower of the two algorithms' best Q, per density
-  std::string smoothing = "0.68,0.68,0.1";
+  std::string smoothing = kJudgingSmoothingVoxel;
   std::string grid;
   std::uint64_t seed = 1;
   int threads = 0;

@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench_common.h"
+#include "tomorig/core/console.h"
 #include "tomorig/core/error.h"
 #include "tomorig/storage/session_file.h"
 
@@ -80,12 +81,16 @@ nlohmann::json record_run(const FrameSet& set, const BenchRecordArgs& args, stor
   const auto start = Clock::now();
   {
     storage::SessionWriter writer(file, info, options);
+    StatusLine status;  // a long run is not silent (issue 23); due() is one clock read per set
     for (int s = 0; s < args.sets; ++s) {
       FrameSet copy = set;  // shares the pixels
       copy.trigger_index = static_cast<std::uint64_t>(s);
       writer.append(copy);
+      if (status.due())
+        status.update(fmt::format("bench record: {} set {}/{}", storage::to_string(compression), s + 1, args.sets));
     }
     writer.finish();
+    status.break_line();
   }
   sync_file(file);
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();

@@ -1,0 +1,39 @@
+#include "json_summary.h"
+
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/core.h>
+
+#include "tomorig/core/error.h"
+
+namespace tomorig::app {
+
+void add_json_flag(CLI::App& cmd, JsonOutput& out) {
+  out.flag = cmd.add_option("--json", out.file,
+                            "Print the summary as one JSON object on stdout, or with a FILE write it there "
+                            "(--json=FILE)")
+                 ->expected(0, 1);
+}
+
+nlohmann::json json_summary(const std::string& command) { return {{json_key::kCommand, command}}; }
+
+void emit_json(const JsonOutput& out, const nlohmann::json& summary) {
+  if (!out.wanted()) return;
+  if (out.file.empty()) {
+    fmt::print("{}\n", summary.dump(2));
+    return;
+  }
+  const std::filesystem::path path(out.file), partial = path.string() + ".partial";
+  {
+    std::ofstream file(partial);
+    file << summary.dump(2) << "\n";
+    if (!file.good())
+      throw runtime_error(fmt::format("--json: cannot write '{}'; check the folder exists and is writable", out.file));
+  }
+  std::error_code ec;
+  std::filesystem::rename(partial, path, ec);
+  if (ec) throw runtime_error(fmt::format("--json: cannot rename '{}' to '{}': {}", partial.string(), out.file, ec.message()));
+}
+
+}  // namespace tomorig::app
