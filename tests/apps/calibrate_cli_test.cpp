@@ -257,9 +257,11 @@ TEST_F(CalibrateCli, PointsOnThreeLinesRefuseRational2AndSoloff3AndTheOthersAreS
   const auto loaded = calibration::load_calibration(out.string());
   ASSERT_EQ(loaded.size(), 1u);
   EXPECT_EQ(loaded[0].model->model_name(), "pinhole");
+  // (45 points with 0.3 px noise on three lines fix a pinhole to a few pixels off the lines;
+  // rational2 on the same points was off by tens of pixels, issue 18.)
   for (const Vec3d world : {Vec3d{3.3, -3.0, 2.5}, Vec3d{-8.0, 6.0, -3.0}, Vec3d{0.0, 0.0, 0.0}}) {
     const Vec2d truth = camera.project(world), fitted = loaded[0].model->project(world);
-    EXPECT_LT(std::hypot(fitted.x - truth.x, fitted.y - truth.y), 1.0);
+    EXPECT_LT(std::hypot(fitted.x - truth.x, fitted.y - truth.y), 5.0);
   }
 
   // Stored rational2: refused, nothing written, the other models still reported (exit 2).
@@ -350,7 +352,9 @@ TEST_F(CalibrateCli, PinholeWithDistortionReproducesABarrelDistortedRigAtHeldOut
       EXPECT_EQ(cv["folds"], 5);
       EXPECT_LT(cv["rms_px"].get<double>(), 0.01) << cv.dump();
     }
-    if (cv["model"] == "pinhole") EXPECT_GT(cv["rms_px"].get<double>(), 0.5) << cv.dump();
+    if (cv["model"] == "pinhole") {
+      EXPECT_GT(cv["rms_px"].get<double>(), 0.5) << cv.dump();
+    }
   }
   const nlohmann::json j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j["results"].size(), 4u);
@@ -436,7 +440,8 @@ TEST_F(CalibrateCli, TheFileDrivesReconstructOnASimulatedSession) {
     cameras.emplace_back(p);
     sizes += fmt::format(" --camera-size {}={},{}", c, t.width, t.height);
   }
-  const std::string points = write_points(csv_rows(cameras, {-1.5, -0.5, 0.5, 1.5}, 5, 6));
+  // A grid the cameras see whole (points outside the image are refused since issue 18).
+  const std::string points = write_points(csv_rows(cameras, {-1.5, -0.5, 0.5, 1.5}, 4.5, 6));
   const std::string calib = (dir_ / "calib.toml").string();
   const CliResult cal = run_tomorig("calibrate --points " + points + " --models pinhole" + sizes + " -o " + shell_quoted(calib));
   ASSERT_EQ(cal.exit_code, 0) << cal.err;
