@@ -1,11 +1,14 @@
 // Residual tables of `tomorig calibrate`; see calibrate_report.h.
 #include "calibrate_report.h"
 
+#include <algorithm>
+#include <cmath>
 #include <map>
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "tomorig/core/error.h"
 #include "tomorig/processing/calibration/fit_camera_model.h"
 
 namespace tomorig::app {
@@ -24,18 +27,112 @@ std::vector<PlaneResidual> plane_residuals(const calibration::CameraModel& model
 }
 
 void print_report(const std::vector<ModelResult>& results, const std::string& stored, const std::string& out) {
-  fmt::print("{:>6}  {:<10} {:>7} {:>7} {:>12} {:>12} {:>10}\n", "camera", "model", "points", "planes", "forward px",
-             "reverse um", "converged");
-  for (const ModelResult& r : results)
-    fmt::print("{:>6}  {:<10} {:>7} {:>7} {:>12.4g} {:>12.4g} {:>10}\n", r.camera, r.report.model, r.report.points,
-               r.report.planes, r.report.forward_mean_px, r.report.reverse_mean_um, r.report.converged ? "yes" : "no");
-  fmt::print("\nper plane:\n{:>6}  {:<10} {:>10} {:>7} {:>12} {:>12}\n", "camera", "model", "z mm", "points", "forward px",
-             "reverse um");
+  fmt::print("{:>6}  {:<10} {:>7} {:>6} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10}\n", "camera", "model", "points",
+             "planes", "fwd RMS px", "mean px", "max px", "rev RMS um", "mean um", "max um", "converged");
+  for (const ModelResult& r : results) {
+    if (!r.error.empty()) {
+      fmt::print("{:>6}  {:<10} {}\n", r.camera, r.report.model, "refused or failed: " + r.error);
+      continue;
+    }
+    const auto& p = r.report;
+    fmt::print("{:>6}  {:<10} {:>7} {:>6} {:>10.4g} {:>10.4g} {:>10.4g} {:>10.4g} {:>10.4g} {:>10.4g} {:>10}\n", r.camera,
+               p.model, p.points, p.planes, p.forward_rms_px, p.forward_mean_px, p.forward_max_px, p.reverse_rms_um,
+               p.reverse_mean_um, p.reverse_max_um, p.converged ? (p.retry.empty() ? "yes" : "yes, retry") : "no");
+  }
+  fmt::print("(forward: image distance between each point and its projection; reverse: world distance between each "
+             "point and the back-projection of its pixel onto its plane, i.e. at the target)\n");
+  fmt::print("\nper plane:\n{:>6}  {:<10} {:>10} {:>7} {:>12} {:>12}\n", "camera", "model", "z mm", "points",
+             "forward px", "reverse um");
   for (const ModelResult& r : results)
     for (const PlaneResidual& p : r.planes)
       fmt::print("{:>6}  {:<10} {:>10.4g} {:>7} {:>12.4g} {:>12.4g}\n", r.camera, r.report.model, p.z_mm, p.points,
                  p.forward_px, p.reverse_um);
-  fmt::print("wrote {} (model {} for every camera)\n", out, stored);
+  if (out.empty() && !stored.empty())
+    fmt::print("nothing written\n");
+  else if (!out.empty())
+    fmt::print("wrote {} (model {} for every camera)\n", out, stored);
+}
+
+CrossValidation cross_validate(const std::string& model, std::span<const calibration::PointCorrespondence> points,
+                               calibration::ImageSize size, const calibration::FitOptions& options, int camera) {
+  CrossValidation cv;
+  cv.camera = camera;
+  cv.model = model;
+  std::map<double, std::vector<calibration::PointCorrespondence>> by_z;
+  for (const auto& p : points) by_z[p.world.z].push_back(p);
+  double squares = 0;
+  for (const auto& [z, left_out] : by_z) {
+    std::vector<calibration::PointCorrespondence> kept;
+    for (const auto& p : points)
+      if (p.world.z != z) kept.push_back(p);
+    try {
+      calibration::FitReport report;
+      const auto fitted = calibration::fit_camera_model(model, kept, size, options, report);
+      for (const auto& p : left_out) {
+        const Vec2d u = fitted->project(p.world);
+        const double d = std::hypot(u.x - p.pixel.x, u.y - p.pixel.y);
+        squares += d * d;
+        cv.max_px = std::max(cv.max_px, d);
+        ++cv.points;
+      }
+      ++cv.folds;
+    } catch (const Error& e) {
+      cv.error = fmt::format("without plane z = {} mm: {}", z, e.what());
+      return cv;
+    }
+  }
+  cv.rms_px = cv.points > 0 ? std::sqrt(squares / cv.points) : 0;
+  return cv;
+}
+
+AutoChoice choose_model(const std::vector<CrossValidation>& results, const std::vector<std::string>& models) {
+  std::vector<std::pair<double, std::string>> ranked;
+  for (const std::string& model : models) {
+    double sum = 0;
+    int cameras = 0;
+    bool usable = true;
+    for (const CrossValidation& cv : results)
+      if (cv.model == model) {
+        usable = usable && cv.error.empty();
+        sum += cv.rms_px;
+        ++cameras;
+      }
+    if (usable && cameras > 0) ranked.push_back({sum / cameras, model});
+  }
+  if (ranked.empty())
+    throw bad_input("--models auto: no model could be cross-validated on every camera (each needs its planes; see the "
+                    "reasons above); list the models with --models");
+  std::sort(ranked.begin(), ranked.end());
+  AutoChoice choice{ranked.front().second, {}};
+  choice.reason = fmt::format("stored {}: the lowest leave-one-plane-out RMS, {:.4g} px averaged over the cameras", choice.model,
+                              ranked.front().first);
+  if (ranked.size() > 1)
+    choice.reason += fmt::format(" (next: {} {:.4g} px)", ranked[1].second, ranked[1].first);
+  return choice;
+}
+
+void print_cross_validation(const std::vector<CrossValidation>& results) {
+  fmt::print("\ncross-validation (each plane left out in turn, the model fitted to the others):\n{:>6}  {:<18} {:>6} "
+             "{:>7} {:>10} {:>10}\n",
+             "camera", "model", "folds", "points", "RMS px", "max px");
+  for (const CrossValidation& cv : results) {
+    if (!cv.error.empty())
+      fmt::print("{:>6}  {:<18} refused or failed: {}\n", cv.camera, cv.model, cv.error);
+    else
+      fmt::print("{:>6}  {:<18} {:>6} {:>7} {:>10.4g} {:>10.4g}\n", cv.camera, cv.model, cv.folds, cv.points, cv.rms_px,
+                 cv.max_px);
+  }
+}
+
+nlohmann::json cross_validation_json(const std::vector<CrossValidation>& results) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const CrossValidation& cv : results) {
+    nlohmann::json j{{"camera", cv.camera}, {"model", cv.model}, {"folds", cv.folds}, {"points", cv.points}};
+    if (!cv.error.empty()) j["error"] = cv.error;
+    else j["rms_px"] = cv.rms_px, j["max_px"] = cv.max_px;
+    list.push_back(j);
+  }
+  return list;
 }
 
 void print_stage_offsets(const StageOffsets& s) {
@@ -75,13 +172,23 @@ nlohmann::json report_json(const std::vector<ModelResult>& results) {
     nlohmann::json planes = nlohmann::json::array();
     for (const PlaneResidual& p : r.planes)
       planes.push_back({{"z_mm", p.z_mm}, {"points", p.points}, {"forward_px", p.forward_px}, {"reverse_um", p.reverse_um}});
+    if (!r.error.empty()) {
+      list.push_back({{"camera", r.camera}, {"model", r.report.model}, {"error", r.error}});
+      continue;
+    }
+    const auto& p = r.report;
     list.push_back({{"camera", r.camera},
-                    {"model", r.report.model},
-                    {"points", r.report.points},
-                    {"planes", r.report.planes},
-                    {"forward_px", r.report.forward_mean_px},
-                    {"reverse_um", r.report.reverse_mean_um},
-                    {"converged", r.report.converged},
+                    {"model", p.model},
+                    {"points", p.points},
+                    {"planes", p.planes},
+                    {"forward_px", p.forward_mean_px},
+                    {"forward_rms_px", p.forward_rms_px},
+                    {"forward_max_px", p.forward_max_px},
+                    {"reverse_um", p.reverse_mean_um},
+                    {"reverse_rms_um", p.reverse_rms_um},
+                    {"reverse_max_um", p.reverse_max_um},
+                    {"converged", p.converged},
+                    {"retry", p.retry},
                     {"per_plane", planes}});
   }
   return list;

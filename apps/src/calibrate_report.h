@@ -24,6 +24,7 @@ struct ModelResult {
   int camera = 0;
   calibration::FitReport report;
   std::vector<PlaneResidual> planes;  // by increasing z
+  std::string error;                  // why the model was refused or failed ("" if fitted)
 };
 
 // Residuals of `model` on each plane (points grouped by equal z) of `points`.
@@ -45,7 +46,34 @@ struct StageOffsets {
 void print_stage_offsets(const StageOffsets& s);
 nlohmann::json stage_offsets_json(const StageOffsets& s);
 
-// Plain-text tables: one row per camera and model, then one per camera, model and plane.
+// Leave-one-plane-out cross-validation of one model on one camera: each plane in turn is left
+// out, the model fitted to the others and its error measured on the plane left out.
+struct CrossValidation {
+  int camera = 0;
+  std::string model;
+  int folds = 0;           // planes left out in turn
+  int points = 0;          // points evaluated (all of them, each once)
+  double rms_px = 0;       // forward residual on the left-out planes
+  double max_px = 0;
+  std::string error;       // why a fold could not be fitted ("" if all could)
+};
+CrossValidation cross_validate(const std::string& model, std::span<const calibration::PointCorrespondence> points,
+                               calibration::ImageSize size, const calibration::FitOptions& options, int camera);
+
+// --models auto: the model whose cross-validated RMS, averaged over the cameras, is lowest among
+// those that every camera could fit; the reason names the runner-up. Throws bad_input if none.
+struct AutoChoice {
+  std::string model;
+  std::string reason;
+};
+AutoChoice choose_model(const std::vector<CrossValidation>& results, const std::vector<std::string>& models);
+
+void print_cross_validation(const std::vector<CrossValidation>& results);
+nlohmann::json cross_validation_json(const std::vector<CrossValidation>& results);
+
+// Plain-text tables: one row per camera and model (RMS, mean and max of the forward residual in
+// px and of the reverse residual in um at the target; a refused model's reason), then one per
+// camera, model and plane. `out` empty: nothing was written.
 void print_report(const std::vector<ModelResult>& results, const std::string& stored, const std::string& out);
 nlohmann::json report_json(const std::vector<ModelResult>& results);
 

@@ -67,9 +67,18 @@ struct CalibrateArgs {
   std::string image_size;
   std::vector<std::string> camera_sizes;
   int max_iterations = calibration::FitOptions{}.max_iterations;
+  // The refractive model's window (--window-*): thickness, indices, approximate pose.
+  double window_thickness_mm = -1;  // < 0: no window given
+  std::string indices = "1.0,1.49,1.33";
+  double window_face_mm = 0;
+  std::string window_normal = "0,0,1";
+  bool fix_window = false;
+  bool fit_medium_index = false;
   std::string out;
+  std::string check;  // --check CALIB: evaluate a calibration on --points instead of fitting
   bool overwrite = false;
   bool json = false;
+  bool cross_validate = false;  // leave one plane out, per camera and model
 };
 
 std::vector<std::string> split_list(const std::string& text) {
@@ -85,7 +94,7 @@ std::vector<std::string> split_list(const std::string& text) {
 
 // "--models pinhole,rational2": known names, no repeats.
 std::vector<std::string> parse_models(const std::string& text) {
-  const auto& known = calibration::camera_model_names();
+  const auto& known = calibration::all_camera_model_names();
   const std::vector<std::string> models = split_list(text);
   for (std::size_t k = 0; k < models.size(); ++k) {
     if (std::find(known.begin(), known.end(), models[k]) == known.end())
@@ -201,6 +210,64 @@ std::vector<double> parse_z_list(const std::string& text) {
   return z;
 }
 
+// "a,b,c" -> numbers, exactly `count` of them, each finite.
+std::vector<double> parse_numbers(const std::string& text, std::size_t count, const std::string& option,
+                                  const std::string& example) {
+  std::vector<double> out;
+  for (const std::string& item : split_list(text)) {
+    double value = 0;
+    const auto [ptr, ec] = std::from_chars(item.data(), item.data() + item.size(), value);
+    if (item.empty() || ec != std::errc() || ptr != item.data() + item.size() || !std::isfinite(value))
+      throw bad_input(fmt::format("{} '{}': '{}' is not a number; expected {}", option, text, item, example));
+    out.push_back(value);
+  }
+  if (out.size() != count)
+    throw bad_input(fmt::format("{} '{}': {} values, expected {}: {}", option, text, out.size(), count, example));
+  return out;
+}
+
+// The window of the refractive model from --window-thickness, --indices, --window-face and
+// --window-normal; nullopt if no thickness was given.
+std::optional<calibration::FlatWindow> window_of(const CalibrateArgs& args, const std::vector<std::string>& models) {
+  const bool wanted = std::find(models.begin(), models.end(), "refractive") != models.end();
+  if (args.window_thickness_mm < 0) {
+    if (wanted)
+      throw bad_input("the refractive model needs the window: give --window-thickness MM (and --indices "
+                      "n_air,n_window,n_medium, --window-face MM, --window-normal X,Y,Z as they apply)");
+    return std::nullopt;
+  }
+  if (!wanted) throw bad_input("--window-thickness goes with the refractive model; add refractive to --models");
+  calibration::FlatWindow w;
+  w.thickness_mm = args.window_thickness_mm;
+  const auto n = parse_numbers(args.indices, 3, "--indices", "n_air,n_window,n_medium, e.g. 1.0,1.49,1.33");
+  w.n_air = n[0], w.n_window = n[1], w.n_medium = n[2];
+  const auto v = parse_numbers(args.window_normal, 3, "--window-normal", "X,Y,Z, e.g. 0,0,1");
+  const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  if (!(length > 0)) throw bad_input("--window-normal must not be zero");
+  w.normal = {v[0] / length, v[1] / length, v[2] / length};
+  w.medium_face_mm = args.window_face_mm;
+  if (const std::string problem = w.validate(); !problem.empty()) throw bad_input("window: " + problem);
+  return w;
+}
+
+// A point outside its camera's image is a wrong point or a wrong --image-size; either would be
+// stored as a calibration that does not match the images.
+void check_inside_images(const std::string& file, const CorrespondenceTable& table,
+                         const std::vector<calibration::ImageSize>& sizes) {
+  for (std::size_t c = 0; c < table.cameras.size(); ++c)
+    for (std::size_t k = 0; k < table.cameras[c].size(); ++k) {
+      const Vec2d& p = table.cameras[c][k].pixel;
+      const calibration::ImageSize s = sizes[c];
+      // Pixel centres at integers: an image of width W spans [-0.5, W - 0.5].
+      if (p.x >= -0.5 && p.x <= s.width - 0.5 && p.y >= -0.5 && p.y <= s.height - 0.5) continue;
+      const std::string line = c < table.lines.size() && k < table.lines[c].size() ? fmt::format(":{}", table.lines[c][k]) : "";
+      throw bad_input(fmt::format("{}{}: camera {}: the image point ({}, {}) px lies outside the camera's {} x {} px image "
+                                  "(pixels span -0.5 to W-0.5); check the point, or give the true size with "
+                                  "--image-size W,H or --camera-size {}=W,H",
+                                  file, line, c, p.x, p.y, s.width, s.height, c));
+    }
+}
+
 Inputs read_inputs(const CalibrateArgs& args) {
   const int sources = !args.points.empty() + !args.images.empty() + !args.image_list.empty() + !args.session.empty();
   if (sources != 1)
@@ -212,6 +279,7 @@ Inputs read_inputs(const CalibrateArgs& args) {
   if (!args.points.empty()) {
     in.table = read_correspondence_csv(args.points);
     in.sizes = image_sizes(args, in.table.cameras.size());
+    check_inside_images(args.points, in.table, in.sizes);
     for (std::size_t c = 0; c < in.table.cameras.size(); ++c) in.camera_names.push_back(fmt::format("camera {}", c));
     return in;
   }
@@ -239,11 +307,44 @@ Inputs read_inputs(const CalibrateArgs& args) {
   return in;
 }
 
+// --check CALIB --points PTS: the calibration's error on points (normally not used in its
+// fit), per camera, in the residual table's terms.
+void run_check(const CalibrateArgs& args) {
+  if (args.points.empty())
+    throw bad_input("--check CALIB needs --points PTS: the point correspondences to evaluate the calibration on");
+  if (!args.out.empty()) throw bad_input("--check evaluates a calibration; it writes nothing, so -o does not go with it");
+  const auto calibrations = calibration::load_calibration(args.check);
+  const CorrespondenceTable table = read_correspondence_csv(args.points);
+  std::vector<ModelResult> results;
+  for (std::size_t i = 0; i < table.cameras.size(); ++i) {
+    const auto found = std::find_if(calibrations.begin(), calibrations.end(),
+                                    [&](const calibration::CameraCalibration& c) { return c.id == static_cast<int>(i); });
+    if (found == calibrations.end())
+      throw bad_input(fmt::format("{}: camera {} has points, but {} has no camera with id {}", args.points, i, args.check, i));
+    calibration::FitReport report = found->report;
+    calibration::measure_residuals(*found->model, table.cameras[i], report);
+    report.camera = fmt::format("camera {}", i);
+    report.retry.clear();
+    results.push_back({static_cast<int>(i), report, plane_residuals(*found->model, table.cameras[i])});
+  }
+  if (args.json) {
+    fmt::print("{}\n", nlohmann::json{{"check", args.check}, {"points", args.points}, {"results", report_json(results)}}.dump(2));
+    return;
+  }
+  fmt::print("{} on the points of {} (not fitted: the residuals are its error there)\n", args.check, args.points);
+  print_report(results, "", "");
+}
+
 void run(const CalibrateArgs& args) {
+  if (!args.check.empty()) return run_check(args);
+  if (args.out.empty()) throw bad_input("-o,--out CALIB.toml is required: the calibration file to write");
   // Before any fit: an existing calibration is never replaced without --overwrite.
   storage::check_output_path(args.out, args.overwrite, "calibration");
-  const std::vector<std::string> models = parse_models(args.models);
-  const std::string stored = args.store.empty() ? models.back() : args.store;
+  const bool automatic = args.models == "auto";
+  std::vector<std::string> models = automatic ? calibration::camera_model_names() : parse_models(args.models);
+  if (automatic && args.window_thickness_mm >= 0) models.push_back("refractive");
+  if (automatic && !args.store.empty()) throw bad_input("--models auto chooses the stored model; --store does not go with it");
+  std::string stored = args.store.empty() ? models.back() : args.store;
   if (std::find(models.begin(), models.end(), stored) == models.end())
     throw bad_input(fmt::format("--store {} is not one of --models {}; the stored model must be fitted", stored,
                                 args.models));
@@ -251,6 +352,7 @@ void run(const CalibrateArgs& args) {
     throw bad_input(fmt::format("--max-iterations {} is invalid: it must be >= 1", args.max_iterations));
   if (!args.points.empty() && !args.points_out.empty())
     throw bad_input("--points-out writes the points detected in target images; it does not go with --points");
+  const std::optional<calibration::FlatWindow> window = window_of(args, models);
   const Inputs in = read_inputs(args);
 
   // With --stage-correction, every model is fitted to the corrected points (docs/calibration.md,
@@ -261,27 +363,64 @@ void run(const CalibrateArgs& args) {
     options.final_model = models.back();
     options.camera_names = in.camera_names;
     options.fit.max_iterations = args.max_iterations;
+    options.fit.window = window;
+    options.fit.fit_window_pose = !args.fix_window;
+    options.fit.fit_medium_index = args.fit_medium_index;
     traverse = calibration::correct_traverse(in.table.cameras, in.sizes, options);
   }
 
+  const auto fit_options = [&](std::size_t camera) {
+    calibration::FitOptions options;
+    options.camera = fmt::format("camera {}", camera);
+    options.max_iterations = args.max_iterations;
+    options.window = window;
+    options.fit_window_pose = !args.fix_window;
+    options.fit_medium_index = args.fit_medium_index;
+    return options;
+  };
+  const auto points_of = [&](std::size_t camera) -> const std::vector<calibration::PointCorrespondence>& {
+    return traverse ? traverse->corrected_points[camera] : in.table.cameras[camera];
+  };
+  std::vector<CrossValidation> validation;
+  if (args.cross_validate || automatic) {
+    for (std::size_t i = 0; i < in.table.cameras.size(); ++i)
+      for (const std::string& model_name : models)
+        validation.push_back(cross_validate(model_name, points_of(i), in.sizes[i], fit_options(i), static_cast<int>(i)));
+    if (automatic) {
+      const AutoChoice choice = choose_model(validation, models);
+      stored = choice.model;
+      fmt::print(stderr, "--models auto: {}\n", choice.reason);
+    }
+  }
+
+  // Every camera and model is fitted and reported on its own: a model the points cannot
+  // determine, or a fit that fails, is reported beside the others instead of ending the run.
   std::vector<ModelResult> results;
   std::vector<calibration::CameraCalibration> calibrations;
+  std::optional<ErrorKind> stored_failure;
   for (std::size_t i = 0; i < in.table.cameras.size(); ++i) {
-    calibration::FitOptions options;
-    options.camera = fmt::format("camera {}", i);
-    options.max_iterations = args.max_iterations;
-    const std::vector<calibration::PointCorrespondence>& points =
-        traverse ? traverse->corrected_points[i] : in.table.cameras[i];
+    const calibration::FitOptions options = fit_options(i);
+    const std::vector<calibration::PointCorrespondence>& points = points_of(i);
     for (const std::string& model_name : models) {
       calibration::FitReport report;
+      report.model = model_name;
+      report.camera = options.camera;
       std::unique_ptr<calibration::CameraModel> model;
-      if (traverse && model_name == models.back()) {
-        model = std::move(traverse->models[i]);
-        report = traverse->reports[i];
-      } else {
-        // Errors (too few points, one plane, degenerate geometry, no convergence) propagate
-        // with the camera named; nothing is written unless every fit succeeds.
-        model = calibration::fit_camera_model(model_name, points, in.sizes[i], options, report);
+      try {
+        if (traverse && model_name == models.back()) {
+          model = std::move(traverse->models[i]);
+          report = traverse->reports[i];
+        } else {
+          model = calibration::fit_camera_model(model_name, points, in.sizes[i], options, report);
+        }
+      } catch (const Error& e) {
+        fmt::print(stderr, "{} {}: {}: {}\n", model_name == stored ? "error" : "warning", model_name,
+                   e.kind() == ErrorKind::bad_input ? "refused" : "failed", e.what());
+        ModelResult failed{static_cast<int>(i), report, {}};
+        failed.error = e.what();
+        results.push_back(std::move(failed));
+        if (model_name == stored && !stored_failure) stored_failure = e.kind();
+        continue;
       }
       std::vector<PlaneResidual> planes = plane_residuals(*model, points);
       // Corrected points sit at nominal z + offset; report the planes by their nominal z.
@@ -291,19 +430,44 @@ void run(const CalibrateArgs& args) {
       if (model_name == stored) calibrations.push_back({static_cast<int>(i), in.sizes[i], std::move(model), report});
     }
   }
-  calibration::save_calibration(args.out, calibrations);
+  // Nothing is written unless the stored model fitted every camera.
+  if (!stored_failure) calibration::save_calibration(args.out, calibrations);
+  // A stored model that misses its own points by this much will misplace particles.
+  constexpr double kWarnRmsPx = 0.5;
+  for (const auto& c : calibrations)
+    if (c.report.forward_rms_px > kWarnRmsPx)
+      fmt::print(stderr,
+                 "warning: camera {}: the stored {} model leaves {:.3g} px RMS (max {:.3g} px) on its own points, above "
+                 "{} px; reconstruction with it will lose or misplace particles: check the points, or fit a model "
+                 "that follows the optics (pinhole_distortion, refractive, rational2)\n",
+                 c.id, c.report.model, c.report.forward_rms_px, c.report.forward_max_px, kWarnRmsPx);
+  const std::string written = stored_failure ? std::string() : args.out;
 
   std::optional<StageOffsets> offsets;
   if (traverse)
     offsets = StageOffsets{traverse->plane_z_mm, traverse->offsets_mm, traverse->per_camera_offsets_mm,
                            in.camera_names, traverse->cycles, traverse->converged};
   if (args.json) {
-    nlohmann::json j{{"results", report_json(results)}, {"stored", stored}, {"out", args.out}};
+    nlohmann::json j{{"results", report_json(results)}, {"stored", stored}};
+    j["out"] = written.empty() ? nlohmann::json(nullptr) : nlohmann::json(written);
     j["stage_correction"] = offsets ? stage_offsets_json(*offsets) : nlohmann::json(nullptr);
+    if (!validation.empty()) j["cross_validation"] = cross_validation_json(validation);
     fmt::print("{}\n", j.dump(2));
   } else {
     if (offsets) print_stage_offsets(*offsets);
-    print_report(results, stored, args.out);
+    print_report(results, stored, written);
+    if (!validation.empty()) print_cross_validation(validation);
+  }
+  if (stored_failure) {
+    std::vector<int> cameras;
+    for (const ModelResult& r : results)
+      if (!r.error.empty() && r.report.model == stored) cameras.push_back(r.camera);
+    const std::string message =
+        fmt::format("no calibration written: the stored model {} failed for camera {} (reasons above); store another "
+                    "model with --store, or fix the points",
+                    stored, fmt::join(cameras, ", "));
+    if (*stored_failure == ErrorKind::bad_input) throw bad_input(message);
+    throw runtime_error(message);
   }
 }
 
@@ -341,8 +505,9 @@ void add_calibrate_command(CLI::App& root) {
       ->capture_default_str();
   cmd->add_option("--points-out", args->points_out, "Also write the detected points as a correspondence CSV");
   cmd->add_option("--models", args->models,
-                  "Models to fit, comma-separated: " + fmt::format("{}", fmt::join(calibration::camera_model_names(), ",")) +
-                      "; each is fitted and reported, the last one is stored")
+                  "Models to fit, comma-separated: " + fmt::format("{}", fmt::join(calibration::all_camera_model_names(), ",")) +
+                      "; each is fitted and reported, the last one is stored; auto: all of them, storing the one with the lowest "
+                      "leave-one-plane-out error")
       ->capture_default_str();
   cmd->add_option("--store", args->store, "Model to store in the calibration file (default: the last of --models)");
   cmd->add_option("--image-size", args->image_size, "Image size W,H in pixels of every camera");
@@ -350,9 +515,27 @@ void add_calibrate_command(CLI::App& root) {
   cmd->add_option("--max-iterations", args->max_iterations,
                   "Levenberg-Marquardt iterations per fit; a fit that does not converge within them fails (exit 1)")
       ->capture_default_str();
-  cmd->add_option("-o,--out", args->out, "Calibration file to write (.toml)")->required();
+  cmd->add_option("--window-thickness", args->window_thickness_mm,
+                  "refractive model: thickness of the flat window between cameras (in air) and medium, mm");
+  cmd->add_option("--indices", args->indices, "refractive model: indices n_air,n_window,n_medium")->capture_default_str();
+  cmd->add_option("--window-face", args->window_face_mm,
+                  "refractive model: position of the window's medium-side face, mm along --window-normal (normal . X); "
+                  "the start of the fit unless --fix-window")
+      ->capture_default_str();
+  cmd->add_option("--window-normal", args->window_normal,
+                  "refractive model: window normal X,Y,Z in world coordinates, pointing from the cameras into the medium")
+      ->capture_default_str();
+  cmd->add_flag("--fix-window", args->fix_window, "refractive model: keep the window pose as given instead of fitting it");
+  cmd->add_flag("--fit-medium-index", args->fit_medium_index, "refractive model: fit n_medium too");
+  cmd->add_option("-o,--out", args->out, "Calibration file to write (.toml)");
+  cmd->add_option("--check", args->check,
+                  "Evaluate this calibration file on --points (points not used in its fit) instead of fitting: RMS, "
+                  "mean and max residuals per camera");
   cmd->add_flag("--overwrite", args->overwrite, "Replace the calibration file if it exists");
   cmd->add_flag("--json", args->json, "Print the report as one JSON object");
+  cmd->add_flag("--cross-validate", args->cross_validate,
+                "Also report each model's leave-one-plane-out error per camera (fit on the other planes, RMS px on the "
+                "plane left out)");
   cmd->callback([args] { run(*args); });
 }
 

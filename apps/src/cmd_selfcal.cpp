@@ -1,6 +1,7 @@
 // tomorig selfcal: volume self-calibration (thesis Sect. 2.2, Wieneke 2008) of a calibration
 // with the particle images of a session (pipeline::selfcal_session); prints the disparities
 // before and after (Table 5.4) and writes the corrected calibration file.
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -142,6 +143,18 @@ pipeline::SessionSelfcalOptions options_of(const SelfcalArgs& args) {
 
 nlohmann::json report_json(const SelfcalArgs& args, const pipeline::SessionSelfcalReport& s) {
   const calibration::SelfCalibrationResult& r = s.result;
+  // Disparities near the first pass's search radius: larger ones were cut off by it, so the
+  // "before" figures understate the misalignment and the correction may miss it (issue 18).
+  if (!r.passes.empty())
+    for (std::size_t c = 0; c < r.before().cameras.size(); ++c) {
+      const double radius = r.before().search_radius_px, largest = r.before().cameras[c].volume.max_px;
+      if (largest >= 0.75 * radius)
+        fmt::print(stderr,
+                   "warning: camera {}: sub-volume disparities before correction reach {:.2f} px, close to the "
+                   "{:.2f} px search radius; larger misalignments are cut off by it and the 'before' figures "
+                   "understate them: rerun with --search-radius {:.3g}\n",
+                   c, largest, radius, std::min(20.0, 2 * radius));
+    }
   nlohmann::json cams = nlohmann::json::array();
   for (std::size_t c = 0; c < r.models.size(); ++c) {
     nlohmann::json j = {{"camera", c},
@@ -182,6 +195,18 @@ void run(const SelfcalArgs& args) {
   const pipeline::SessionSelfcalReport s = pipeline::selfcal_session(
       args.session, options_of(args), [](const std::string& text) { fmt::print(stderr, "{}\n", text); });
   const calibration::SelfCalibrationResult& r = s.result;
+  // Disparities near the first pass's search radius: larger ones were cut off by it, so the
+  // "before" figures understate the misalignment and the correction may miss it (issue 18).
+  if (!r.passes.empty())
+    for (std::size_t c = 0; c < r.before().cameras.size(); ++c) {
+      const double radius = r.before().search_radius_px, largest = r.before().cameras[c].volume.max_px;
+      if (largest >= 0.75 * radius)
+        fmt::print(stderr,
+                   "warning: camera {}: sub-volume disparities before correction reach {:.2f} px, close to the "
+                   "{:.2f} px search radius; larger misalignments are cut off by it and the 'before' figures "
+                   "understate them: rerun with --search-radius {:.3g}\n",
+                   c, largest, radius, std::min(20.0, 2 * radius));
+    }
   // Not converged: report, then fail without writing a calibration that is not good enough.
   if (r.converged) calibration::save_calibration(args.out, s.calibration);
   if (args.json) {

@@ -99,6 +99,8 @@ CorrespondenceTable read_correspondence_csv(const std::filesystem::path& path) {
   std::size_t field_count = 0;
   std::string text;
   for (int line = 1; std::getline(in, text); ++line) {
+    // A UTF-8 byte-order mark (spreadsheets write one) is not part of the first header name.
+    if (line == 1 && text.starts_with("\xEF\xBB\xBF")) text.erase(0, 3);
     const std::string_view row = trimmed(text);
     if (skipped(row)) continue;
     if (!columns) {
@@ -117,8 +119,12 @@ CorrespondenceTable read_correspondence_csv(const std::filesystem::path& path) {
     calibration::PointCorrespondence point;
     point.world = {parse_number(field(kX), at(kX)), parse_number(field(kY), at(kY)), parse_number(field(kZ), at(kZ))};
     point.pixel = {parse_number(field(kPixelX), at(kPixelX)), parse_number(field(kPixelY), at(kPixelY))};
-    if (camera >= static_cast<int>(table.cameras.size())) table.cameras.resize(static_cast<std::size_t>(camera) + 1);
+    if (camera >= static_cast<int>(table.cameras.size())) {
+      table.cameras.resize(static_cast<std::size_t>(camera) + 1);
+      table.lines.resize(static_cast<std::size_t>(camera) + 1);
+    }
     table.cameras[static_cast<std::size_t>(camera)].push_back(point);
+    table.lines[static_cast<std::size_t>(camera)].push_back(line);
   }
   if (!columns) throw bad_input(fmt::format("{}: empty file; expected the header camera,X,Y,Z,x,y and one row per point", path.string()));
   if (table.cameras.empty()) throw bad_input(fmt::format("{}: the file has a header but no points", path.string()));

@@ -106,6 +106,12 @@ TEST_F(SelfcalCli, NonConvergenceExitsOneNamingTheCameraAndWritesNothing) {
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find("camera 2"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(out));
+  // Issue 18: a search radius the disparities reach is named, with the radius to use.
+  const CliResult small = run_tomorig("selfcal --session " + shell_quoted(session_) + " --calib " +
+                                      shell_quoted(misaligned_) + " --search-radius 0.8 --min-search-radius 0.8 "
+                                      "--max-iterations 0 -o " + shell_quoted(out));
+  EXPECT_NE(small.err.find("close to the 0.80 px search radius"), std::string::npos) << small.err;
+  EXPECT_NE(small.err.find("rerun with --search-radius 1.6"), std::string::npos) << small.err;
 }
 
 TEST_F(SelfcalCli, BadInputExitsTwo) {

@@ -9,6 +9,8 @@
 #include "tomorig/core/error.h"
 #include "tomorig/processing/calibration/calibration_file.h"
 #include "tomorig/processing/calibration/dlt_camera.h"
+#include "tomorig/processing/calibration/lens_camera.h"
+#include "tomorig/processing/calibration/refractive_camera.h"
 #include "tomorig/processing/calibration/pinhole_camera.h"
 #include "tomorig/processing/calibration/polynomial_camera.h"
 #include "tomorig/processing/calibration/two_plane_camera.h"
@@ -104,6 +106,9 @@ FitReport read_report(const CameraReader& r, const toml::table& cam, const std::
   rep.forward_max_px = r.number(t, p, "forward_max_px");
   rep.reverse_mean_um = r.number(t, p, "reverse_mean_um");
   rep.reverse_max_um = r.number(t, p, "reverse_max_um");
+  // RMS since issue 18; older files have the mean only, which then stands in for it.
+  rep.forward_rms_px = t.contains("forward_rms_px") ? r.number(t, p, "forward_rms_px") : rep.forward_mean_px;
+  rep.reverse_rms_um = t.contains("reverse_rms_um") ? r.number(t, p, "reverse_rms_um") : rep.reverse_mean_um;
   if (t.contains("inverse_mapping_mean_um")) rep.inverse_mapping_mean_um = r.number(t, p, "inverse_mapping_mean_um");
   rep.iterations = static_cast<int>(r.integer(t, p, "iterations"));
   rep.converged = r.boolean(t, p, "converged");
@@ -131,7 +136,7 @@ std::shared_ptr<const CameraModel> read_model(const CameraReader& r, const toml:
                                               const Normalization& n) {
   const toml::table& c = r.table(cam, "", "coefficients");
   const std::string p = "coefficients.";
-  if (model == "pinhole") {
+  if (model == "pinhole" || model == "pinhole_distortion" || model == "refractive") {
     PinholeParameters pp;
     pp.fx = r.number(c, p, "fx");
     pp.fy = r.number(c, p, "fy");
@@ -141,7 +146,20 @@ std::shared_ptr<const CameraModel> read_model(const CameraReader& r, const toml:
     const auto t = r.numbers(c, p, "t", 3);
     std::copy(R.begin(), R.end(), pp.R.begin());
     pp.t = {t[0], t[1], t[2]};
-    return construct(r, [&] { return std::make_shared<PinholeCamera>(pp); });
+    if (model == "pinhole") return construct(r, [&] { return std::make_shared<PinholeCamera>(pp); });
+    const auto k = r.numbers(c, p, "radial", 3);
+    const auto tangential = r.numbers(c, p, "tangential", 2);
+    const LensDistortion d{k[0], k[1], k[2], tangential[0], tangential[1]};
+    if (model == "pinhole_distortion") return construct(r, [&] { return std::make_shared<LensCamera>(pp, d); });
+    FlatWindow w;
+    const auto normal = r.numbers(c, p, "window_normal", 3);
+    w.normal = {normal[0], normal[1], normal[2]};
+    w.medium_face_mm = r.number(c, p, "window_medium_face_mm");
+    w.thickness_mm = r.number(c, p, "window_thickness_mm");
+    w.n_air = r.number(c, p, "n_air");
+    w.n_window = r.number(c, p, "n_window");
+    w.n_medium = r.number(c, p, "n_medium");
+    return construct(r, [&] { return std::make_shared<RefractiveCamera>(LensCamera(pp, d), w); });
   }
   if (model == "dlt") {
     const auto a = r.numbers(c, p, "matrix", 12);
@@ -171,7 +189,7 @@ std::shared_ptr<const CameraModel> read_model(const CameraReader& r, const toml:
     const int steps = newton_steps(r, c, p);
     return construct(r, [&] { return std::make_shared<TwoPlaneCamera>(n, mappings, steps); });
   }
-  r.fail("model", fmt::format("= \"{}\" is not a known model (pinhole, dlt, twoplane, rational2, soloff3)", model));
+  r.fail("model", fmt::format("= \"{}\" is not a known model (pinhole, dlt, pinhole_distortion, refractive, twoplane, rational2, soloff3)", model));
 }
 
 }  // namespace

@@ -8,6 +8,8 @@
 #include "tomorig/core/error.h"
 #include "tomorig/processing/calibration/calibration_file.h"
 #include "tomorig/processing/calibration/dlt_camera.h"
+#include "tomorig/processing/calibration/lens_camera.h"
+#include "tomorig/processing/calibration/refractive_camera.h"
 #include "tomorig/processing/calibration/pinhole_camera.h"
 #include "tomorig/processing/calibration/polynomial_camera.h"
 #include "tomorig/processing/calibration/two_plane_camera.h"
@@ -49,12 +51,31 @@ const Normalization& normalization_of(const CameraModel& model, const FitReport&
   return report.normalization;
 }
 
+void write_lens(std::string& out, const LensCamera& l) {
+  const auto& p = l.pinhole().parameters();
+  const auto& d = l.distortion();
+  out += fmt::format("fx = {}\nfy = {}\ncx = {}\ncy = {}\n", number(p.fx), number(p.fy), number(p.cx), number(p.cy));
+  out += fmt::format("R = {}\nt = {}\n", array(p.R), array(std::array{p.t.x, p.t.y, p.t.z}));
+  out += fmt::format("radial = {}\ntangential = {}\n", array(std::array{d.k1, d.k2, d.k3}), array(std::array{d.p1, d.p2}));
+}
+
 void write_model(std::string& out, const CameraModel& model, int id) {
   if (const auto* m = dynamic_cast<const PinholeCamera*>(&model)) {
     const auto& p = m->parameters();
     out += "\n[camera.coefficients]\n";
     out += fmt::format("fx = {}\nfy = {}\ncx = {}\ncy = {}\n", number(p.fx), number(p.fy), number(p.cx), number(p.cy));
     out += fmt::format("R = {}\nt = {}\n", array(p.R), array(std::array{p.t.x, p.t.y, p.t.z}));
+  } else if (const auto* l = dynamic_cast<const LensCamera*>(&model)) {
+    out += "\n[camera.coefficients]\n";
+    write_lens(out, *l);
+  } else if (const auto* rc = dynamic_cast<const RefractiveCamera*>(&model)) {
+    out += "\n[camera.coefficients]\n";
+    write_lens(out, rc->lens());
+    const FlatWindow& w = rc->window();
+    out += fmt::format("window_normal = {}\nwindow_medium_face_mm = {}\nwindow_thickness_mm = {}\n",
+                       array(std::array{w.normal.x, w.normal.y, w.normal.z}), number(w.medium_face_mm),
+                       number(w.thickness_mm));
+    out += fmt::format("n_air = {}\nn_window = {}\nn_medium = {}\n", number(w.n_air), number(w.n_window), number(w.n_medium));
   } else if (const auto* d = dynamic_cast<const DltCamera*>(&model)) {
     out += fmt::format("\n[camera.coefficients]\nmatrix = {}\n", array(d->matrix()));
   } else if (const auto* q = dynamic_cast<const PolynomialCamera*>(&model)) {
@@ -73,8 +94,10 @@ void write_model(std::string& out, const CameraModel& model, int id) {
 void write_report(std::string& out, const FitReport& r) {
   out += "\n[camera.fit]\n";
   out += fmt::format("points = {}\nplanes = {}\n", r.points, r.planes);
-  out += fmt::format("forward_mean_px = {}\nforward_max_px = {}\n", number(r.forward_mean_px), number(r.forward_max_px));
-  out += fmt::format("reverse_mean_um = {}\nreverse_max_um = {}\n", number(r.reverse_mean_um), number(r.reverse_max_um));
+  out += fmt::format("forward_rms_px = {}\nforward_mean_px = {}\nforward_max_px = {}\n", number(r.forward_rms_px),
+                     number(r.forward_mean_px), number(r.forward_max_px));
+  out += fmt::format("reverse_rms_um = {}\nreverse_mean_um = {}\nreverse_max_um = {}\n", number(r.reverse_rms_um),
+                     number(r.reverse_mean_um), number(r.reverse_max_um));
   if (r.inverse_mapping_mean_um) out += fmt::format("inverse_mapping_mean_um = {}\n", number(*r.inverse_mapping_mean_um));
   out += fmt::format("iterations = {}\nconverged = {}\n", r.iterations, r.converged ? "true" : "false");
 }

@@ -1,6 +1,7 @@
 // The higher-order models of thesis Appendix A.2.2 and their inverse mappings.
 #include <fmt/core.h>
 
+#include "identifiability.h"
 #include "mapping_fit.h"
 #include "model_fits.h"
 #include "tomorig/core/error.h"
@@ -58,7 +59,7 @@ std::unique_ptr<CameraModel> fit_polynomial(PolynomialKind kind, std::span<const
   const MapForm form = rational ? MapForm{Basis::quadratic, true} : MapForm{Basis::cubic, false};
   const int unknowns = rational ? 29 : 40;
   // z^2 terms need 3 planes; the z^3 term of Eq. A.5 needs 4.
-  const Normalization n = check_points(points, {model, unknowns, rational ? 3 : 4, 0}, options);
+  const Normalization n = check_points(points, {model, unknowns, rational ? 3 : 4, 0, form.basis}, options);
   const Samples s = samples_of(points, n);
   const LmSettings settings = lm_settings(options);
 
@@ -74,10 +75,19 @@ std::unique_ptr<CameraModel> fit_polynomial(PolynomialKind kind, std::span<const
   } else {
     forward_start = inverse_start = soloff3_identity();
   }
-  const MapFit forward = fit_map(form, s.forward, forward_start, settings);
+  MapFit forward = fit_map(form, s.forward, forward_start, settings);
+  if (rational && !forward.lm.converged) {
+    // A second start: the algebraic fit of the projection itself (exact on data that lie on
+    // such a mapping), which often sits closer to the optimum than the DLT does.
+    MapFit second = fit_map(form, s.forward, algebraic_rational_start(form, s.forward), settings);
+    if (second.lm.converged || second.lm.cost < forward.lm.cost) forward = std::move(second);
+  }
   check_fit(forward.lm, unknowns, model, "projection", options, !rational);
   const MapFit inverse = fit_map(form, s.inverse, inverse_start, settings);
   check_fit(inverse.lm, unknowns, model, "inverse mapping", options, !rational);
+  // A ratio must not have a pole inside the box it was calibrated over.
+  require_one_signed_denominator(form, forward.coefficients, s.forward, model, "projection", n, true, points, options);
+  require_one_signed_denominator(form, inverse.coefficients, s.inverse, model, "inverse mapping", n, false, points, options);
 
   report.normalization = n;
   report.iterations = forward.lm.iterations;

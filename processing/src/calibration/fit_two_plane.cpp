@@ -3,6 +3,7 @@
 
 #include <fmt/core.h>
 
+#include "identifiability.h"
 #include "mapping_fit.h"
 #include "model_fits.h"
 #include "tomorig/processing/calibration/two_plane_camera.h"
@@ -32,6 +33,7 @@ std::unique_ptr<CameraModel> fit_two_plane(std::span<const PointCorrespondence> 
     }
     FitOptions plane_options = options;
     plane_options.camera = fmt::format("{}, plane z = {} mm", options.camera, plane.z);
+    require_determined(Basis::cubic_2d, "twoplane", plane.points, compute_normalization(plane.points), plane_options);
     const MapFit world_fit = fit_map(form, to_world, identity, lm_settings(options));
     check_fit(world_fit.lm, 2 * kTerms, "twoplane", "plane mapping to world", plane_options);
     const MapFit image_fit = fit_map(form, to_image, identity, lm_settings(options));

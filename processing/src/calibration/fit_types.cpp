@@ -40,16 +40,23 @@ std::string FitOptions::validate() const {
   if (max_iterations < 1) return fmt::format("max_iterations = {} is invalid: it must be >= 1", max_iterations);
   if (!(tolerance > 0) || !(tolerance < 1))
     return fmt::format("tolerance = {} is invalid: it must be in (0, 1)", tolerance);
+  if (retry_factor < 1 || retry_factor > 100)
+    return fmt::format("retry_factor = {} is invalid: it must be in [1, 100]", retry_factor);
+  if (window)
+    if (const std::string problem = window->validate(); !problem.empty()) return "window: " + problem;
   if (newton_steps < 0 || newton_steps > 50)
     return fmt::format("newton_steps = {} is invalid: it must be in [0, 50]", newton_steps);
   return {};
 }
 
 std::string FitReport::brief() const {
-  std::string line = fmt::format("{} {}: {} points on {} planes, forward mean {:.4f} px (max {:.4f}), reverse mean {:.3f} um",
-                                 camera, model, points, planes, forward_mean_px, forward_max_px, reverse_mean_um);
+  std::string line = fmt::format("{} {}: {} points on {} planes, forward RMS {:.4f} px (mean {:.4f}, max {:.4f}), reverse "
+                                 "RMS {:.3f} um (mean {:.3f}, max {:.3f})",
+                                 camera, model, points, planes, forward_rms_px, forward_mean_px, forward_max_px,
+                                 reverse_rms_um, reverse_mean_um, reverse_max_um);
   if (inverse_mapping_mean_um) line += fmt::format(" (inverse mapping alone {:.3f} um)", *inverse_mapping_mean_um);
   line += fmt::format(", {} iterations, {}", iterations, converged ? "converged" : "NOT converged");
+  if (!retry.empty()) line += " (" + retry + ")";
   return line;
 }
 

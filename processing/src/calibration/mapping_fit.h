@@ -8,12 +8,6 @@
 
 namespace tomorig::calibration::detail {
 
-// Matching inputs (p, q, r) and targets (two outputs), one row per point.
-struct MapSamples {
-  std::vector<std::array<double, 3>> inputs;
-  std::vector<Vec2d> targets;
-};
-
 struct MapFit {
   std::vector<double> coefficients;  // coefficient_count() values
   LmResult lm;

@@ -1,11 +1,13 @@
 #pragma once
 // The per-model fits behind fit_camera_model(), and the input checks they share.
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "levenberg_marquardt.h"
+#include "polynomial_maps.h"
 #include "tomorig/processing/calibration/camera_model.h"
 #include "tomorig/processing/calibration/fit_types.h"
 #include "tomorig/processing/calibration/polynomial_camera.h"
@@ -26,6 +28,10 @@ struct Requirements {
   int unknowns = 0;    // coefficients fitted from the forward residuals (2 per point)
   int min_planes = 2;  // distinct z values
   int min_points_per_plane = 0;
+  // The monomials of the model's mapping: every one must be determined by the points (else the
+  // mapping between them is arbitrary: points on three lines lie on a quadric, and a quadratic
+  // numerator can change by it freely). nullopt: no such check.
+  std::optional<Basis> basis;
 };
 
 // Checks the points and returns their normalisation (Appendix A.1).
@@ -50,6 +56,10 @@ std::unique_ptr<CameraModel> fit_dlt(std::span<const PointCorrespondence> points
                                      FitReport& report);
 std::unique_ptr<CameraModel> fit_pinhole(std::span<const PointCorrespondence> points, const FitOptions& options,
                                          FitReport& report);
+std::unique_ptr<CameraModel> fit_lens(std::span<const PointCorrespondence> points, const FitOptions& options,
+                                      FitReport& report);
+std::unique_ptr<CameraModel> fit_refractive(std::span<const PointCorrespondence> points, const FitOptions& options,
+                                            FitReport& report);
 std::unique_ptr<CameraModel> fit_polynomial(PolynomialKind kind, std::span<const PointCorrespondence> points,
                                             const FitOptions& options, FitReport& report);
 std::unique_ptr<CameraModel> fit_two_plane(std::span<const PointCorrespondence> points, const FitOptions& options,

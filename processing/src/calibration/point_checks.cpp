@@ -6,7 +6,9 @@
 
 #include <Eigen/Dense>
 #include <fmt/core.h>
+#include <fmt/format.h>
 
+#include "identifiability.h"
 #include "model_fits.h"
 #include "tomorig/core/error.h"
 
@@ -105,10 +107,22 @@ Normalization check_points(std::span<const PointCorrespondence> points, const Re
     throw bad_input(fmt::format("{}: all {} points lie on one (tilted) plane; the {} model needs depth: give points on "
                                 "at least {} planes at different z",
                                 cam, points.size(), req.model, req.min_planes));
-  if (static_cast<int>(planes.size()) < req.min_planes)
+  if (static_cast<int>(planes.size()) < req.min_planes) {
+    // Say which terms the planes leave open too, so that points on lines are recognised.
+    std::string terms;
+    if (req.basis) {
+      const BasisCheck check = check_basis(*req.basis, points, compute_normalization(points));
+      if (!check.determined) {
+        std::vector<std::string> list = check.undetermined_terms;
+        if (list.size() > 6) list.resize(6);
+        terms = fmt::format("; {}: the {}{} terms are not determined", describe_layout(points), fmt::join(list, ", "),
+                            check.undetermined_terms.size() > list.size() ? " and more" : "");
+      }
+    }
     throw bad_input(fmt::format("{}: the points lie on {} planes (z = {}); the {} model needs at least {} planes at "
-                                "different z",
-                                cam, planes.size(), plane_list(planes), req.model, req.min_planes));
+                                "different z{}",
+                                cam, planes.size(), plane_list(planes), req.model, req.min_planes, terms));
+  }
   if (req.min_points_per_plane > 0)
     for (std::size_t k = 0; k < planes.size(); ++k) {
       const Plane& plane = planes[k];
@@ -121,7 +135,9 @@ Normalization check_points(std::span<const PointCorrespondence> points, const Re
                                     "plane are collinear",
                                     cam, k, plane.z, req.model));
     }
-  return compute_normalization(points);
+  const Normalization n = compute_normalization(points);
+  if (req.basis) require_determined(*req.basis, req.model, points, n, options);
+  return n;
 }
 
 void check_fit(const LmResult& lm, int parameters, const std::string& model, const std::string& what,

@@ -65,6 +65,12 @@ struct MapForm {
   int coefficient_count() const { return basis_size(basis) * (rational ? 3 : 2); }
 };
 
+// Matching inputs (p, q, r) and targets (two outputs), one row per point.
+struct MapSamples {
+  std::vector<std::array<double, 3>> inputs;
+  std::vector<Vec2d> targets;
+};
+
 // Evaluates the mapping with coefficients c (coefficient_count() values).
 inline Vec2d evaluate_map(const MapForm& form, const double* c, double p, double q, double r) {
   Terms m;

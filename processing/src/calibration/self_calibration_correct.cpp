@@ -9,6 +9,7 @@
 #include "self_calibration_internal.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/calibration/fit_camera_model.h"
+#include "tomorig/processing/calibration/refractive_camera.h"
 
 namespace tomorig::calibration::selfcal {
 namespace {
@@ -99,6 +100,8 @@ std::unique_ptr<CameraModel> refit_with_offsets(const CameraModel& model, ImageS
       }
   FitOptions options;
   options.camera = camera_name;
+  // A refractive camera keeps its window: the refit starts from it (pose fitted again).
+  if (const auto* refractive = dynamic_cast<const RefractiveCamera*>(&model)) options.window = refractive->window();
   return fit_camera_model(model.model_name(), points, image_size, options, report);
 }
 

@@ -23,7 +23,7 @@ using tomorig::calibration::FitOptions;
 using tomorig::calibration::load_calibration;
 using tomorig::calibration::save_calibration;
 
-// One camera per model, ids 0..4, fitted to distorted points once for the whole suite.
+// One camera per model, ids 0..5, fitted to distorted points once for the whole suite.
 std::vector<CameraCalibration> fit_cameras() {
   Truth truth;
   truth.camera = thesis_camera(-14);
@@ -99,7 +99,7 @@ TEST(CalibrationFile, ANanCoefficientIsRefusedNamingCameraAndKey) {
   tomorig::testing::TempDir dir;
   save_calibration(dir / "calib.toml", fitted_cameras());
   std::string text = read_text(dir / "calib.toml");
-  // Camera 3 is rational2 (the order of camera_model_names()): spoil its 8th forward value.
+  // Camera 4 is rational2 (the order of camera_model_names()): spoil its 8th forward value.
   const std::string key = "forward = [";
   std::size_t at = 0;
   for (int seen = 0; seen < 1; ++seen) at = text.find(key, at) + key.size();  // first "forward" list
@@ -108,7 +108,7 @@ TEST(CalibrationFile, ANanCoefficientIsRefusedNamingCameraAndKey) {
   for (int k = 0; k < 7; ++k) value = text.find(", ", value) + 2;
   const std::size_t end = text.find(',', value);
   text.replace(value, end - value, "nan");
-  expect_bad_input(dir.write("nan.toml", text), {"camera 3", "coefficients.forward[7]", "nan"});
+  expect_bad_input(dir.write("nan.toml", text), {"camera 4", "coefficients.forward[7]", "nan"});
 }
 
 TEST(CalibrationFile, MissingOrMistypedValuesAreRefused) {

@@ -84,6 +84,7 @@ TEST(CameraModelBadInput, AFitThatDoesNotConvergeIsAnError) {
   truth.radial_k = 2e-3;
   FitOptions options;
   options.max_iterations = 1;
+  options.retry_factor = 1;  // no second attempt
   expect_error("rational2", grid_points(truth, kFivePlanes, 9, 4.0, 0.05), ErrorKind::runtime,
                {"camera 3", "rational2", "did not converge in 1 iterations"}, options);
   // Asked not to throw, the fit returns and says so in its report.
@@ -92,6 +93,26 @@ TEST(CameraModelBadInput, AFitThatDoesNotConvergeIsAnError) {
   fit_camera_model("rational2", grid_points(truth, kFivePlanes, 9, 4.0, 0.05), {kImageSize, kImageSize}, options,
                    report);
   EXPECT_FALSE(report.converged);
+}
+
+TEST(CameraModelBadInput, AFitThatRunsOutOfIterationsGetsASecondAttemptBeforeItFails) {
+  Truth truth;
+  truth.radial_k = 2e-3;
+  const auto points = grid_points(truth, kFivePlanes, 9, 4.0, 0.05);
+  FitOptions options;
+  options.max_iterations = 2;
+  options.retry_factor = 100;  // 200 iterations: plenty
+  FitReport report;
+  const auto model = fit_camera_model("rational2", points, {kImageSize, kImageSize}, options, report);
+  EXPECT_TRUE(report.converged);
+  EXPECT_EQ(report.retry, "converged on a second attempt with 200 iterations");
+  EXPECT_NE(report.brief().find("second attempt"), std::string::npos) << report.brief();
+  EXPECT_LT(report.forward_rms_px, 0.1);
+  // The failure message says both attempts ran out.
+  options.retry_factor = 2;
+  options.max_iterations = 1;
+  expect_error("rational2", points, ErrorKind::runtime, {"did not converge in 1 iterations, nor in 2 on a second attempt"},
+               options);
 }
 
 TEST(CameraModelBadInput, NonFinitePointUnknownModelAndBadOptions) {

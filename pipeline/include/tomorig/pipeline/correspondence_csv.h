@@ -7,7 +7,7 @@
 // camera: integer index 0..N-1; X, Y, Z: world position in mm; x, y: image position in pixels
 // (pixel convention of camera_model.h); plane: optional integer label, read and checked but
 // not used (planes are told apart by Z). Columns may come in any order; blank lines and lines
-// starting with '#' are skipped. Format: docs/calibration.md, "Command line".
+// starting with '#' are skipped; a UTF-8 byte-order mark and CRLF line ends are accepted. Format: docs/calibration.md, "Command line".
 #include <filesystem>
 #include <vector>
 
@@ -18,6 +18,8 @@ namespace tomorig::pipeline {
 // The points of each camera: cameras[i] holds camera i's points, in file order.
 struct CorrespondenceTable {
   std::vector<std::vector<calibration::PointCorrespondence>> cameras;
+  // lines[i][k]: the file line of cameras[i][k] (read from a file; empty for detected points).
+  std::vector<std::vector<int>> lines;
 };
 
 // Throws tomorig::Error (bad_input) naming the file, the line and the column and saying what is

@@ -7,7 +7,9 @@
 //   auto model = calibration::fit_camera_model("rational2", points, {1600, 1200}, options, report);
 //
 // Models: "dlt" (SVD of the normalised system Eq. A.2, LM on Eq. A.3), "pinhole" (K, R, t
-// from the DLT, LM on Eq. A.3), "rational2" (Eq. A.4, started from the DLT), "soloff3"
+// from the DLT, LM on Eq. A.3), "pinhole_distortion" (the pinhole with radial and tangential
+// lens distortion, lens_camera.h), "refractive" (that behind a flat window, needs
+// FitOptions::window), "rational2" (Eq. A.4, started from the DLT), "soloff3"
 // (Eq. A.5), "twoplane" (per-plane 2-D mappings). See docs/calibration.md.
 //
 // Errors (tomorig::Error, each message names options.camera and, where it applies, the plane):
@@ -25,8 +27,12 @@
 
 namespace tomorig::calibration {
 
-// The model names fit_camera_model() accepts, in the order of increasing complexity.
+// The models fit_camera_model() fits from the points alone, in the order of increasing
+// complexity: pinhole, dlt, pinhole_distortion, twoplane, rational2, soloff3.
 const std::vector<std::string>& camera_model_names();
+// Those and "refractive" (a pinhole with distortion behind a flat window, refractive_camera.h),
+// which also needs FitOptions::window.
+const std::vector<std::string>& all_camera_model_names();
 
 std::unique_ptr<CameraModel> fit_camera_model(std::string_view model_name,
                                               std::span<const PointCorrespondence> points,

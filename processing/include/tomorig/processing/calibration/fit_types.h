@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "tomorig/core/geometry.h"
+#include "tomorig/processing/calibration/flat_window.h"
 
 namespace tomorig::calibration {
 
@@ -55,13 +56,21 @@ struct FitOptions {
   // LM stops when the relative decrease of the squared reprojection error, or the relative
   // size of a step, falls below this.
   double tolerance = 1e-10;
-  // If the LM does not converge within max_iterations: throw (true) or return the last
-  // iterate with report.converged = false (false).
+  // If the LM does not converge within max_iterations, fit_camera_model tries again with
+  // retry_factor times as many iterations (and, for rational2, from a second start) before it
+  // gives up: then throw (true) or return the last iterate with report.converged = false.
   bool require_convergence = true;
+  int retry_factor = 4;  // 1: no second attempt
   // Newton steps on the forward model that polish each back-projection of the polynomial and
   // two-plane models, so that back_project/line_of_sight agree with project (0: use the
   // fitted inverse mapping as it is).
   int newton_steps = 4;
+  // The "refractive" model: the window the cameras look through (required for it). Its
+  // thickness and indices are fixed; its pose (normal and medium face) is the start of the
+  // fit if fit_window_pose, else fixed too. fit_medium_index also fits n_medium.
+  std::optional<FlatWindow> window;
+  bool fit_window_pose = true;
+  bool fit_medium_index = false;
 
   // Empty if valid, else a message naming the field, its value and the rule.
   std::string validate() const;
@@ -73,13 +82,18 @@ struct FitReport {
   int points = 0;
   int planes = 0;      // distinct z values among the points
   double forward_mean_px = 0;  // mean of Eq. A.3 over all points
+  double forward_rms_px = 0;   // root mean square of the same distances (what other tools report)
   double forward_max_px = 0;
   // Mean/max distance (micrometres) between each world point and back_project(its pixel, its z).
   double reverse_mean_um = 0;
+  double reverse_rms_um = 0;
   double reverse_max_um = 0;
   // The same for the fitted inverse mapping alone (soloff3, rational2), before Newton polish.
   std::optional<double> inverse_mapping_mean_um;
   int iterations = 0;  // LM iterations of the forward fit (inverse fit not counted)
+  // How the fit got there if the first attempt did not converge ("" if it did), e.g.
+  // "converged on a second attempt with 2000 iterations".
+  std::string retry;
   bool converged = false;
   Normalization normalization;
 

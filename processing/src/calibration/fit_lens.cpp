@@ -1,0 +1,84 @@
+// The pinhole camera with lens distortion (lens_camera.h): started from the fitted pinhole with
+// no distortion, then Levenberg-Marquardt on the reprojection error (Eq. A.3) over the pinhole's
+// 10 parameters and k1, k2, k3, p1, p2.
+#include <cmath>
+
+#include <Eigen/Dense>
+#include <Eigen/Geometry>
+#include <fmt/core.h>
+
+#include "model_fits.h"
+#include "tomorig/core/error.h"
+#include "tomorig/processing/calibration/lens_camera.h"
+
+namespace tomorig::calibration::detail {
+namespace {
+
+constexpr int kPinholeParameters = 10;  // fx, fy, cx, cy, rotation vector, t
+constexpr int kLensParameters = kPinholeParameters + 5;
+
+PinholeParameters pinhole_of(const Eigen::VectorXd& q) {
+  PinholeParameters pp;
+  pp.fx = q(0), pp.fy = q(1), pp.cx = q(2), pp.cy = q(3);
+  const Eigen::Vector3d r(q(4), q(5), q(6));
+  const double angle = r.norm();
+  const Eigen::Matrix3d rot = angle > 0 ? Eigen::AngleAxisd(angle, r / angle).toRotationMatrix() : Eigen::Matrix3d::Identity();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) pp.R[3 * i + j] = rot(i, j);
+  pp.t = {q(7), q(8), q(9)};
+  return pp;
+}
+
+LensDistortion distortion_of(const Eigen::VectorXd& q) {
+  return {q(10), q(11), q(12), q(13), q(14)};
+}
+
+}  // namespace
+
+std::unique_ptr<CameraModel> fit_lens(std::span<const PointCorrespondence> points, const FitOptions& options,
+                                      FitReport& report) {
+  check_points(points, {"pinhole_distortion", kLensParameters, 2, 0}, options);
+  // The start: the pinhole fit (it need not converge itself; the full fit goes on from it).
+  FitOptions start_options = options;
+  start_options.require_convergence = false;
+  FitReport start_report;
+  const auto start = fit_pinhole(points, start_options, start_report);
+  const PinholeParameters& s = static_cast<const PinholeCamera&>(*start).parameters();
+  const Normalization& n = start_report.normalization;
+
+  Eigen::Matrix3d R;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) R(i, j) = s.R[3 * i + j];
+  const Eigen::AngleAxisd aa(R);
+  const Eigen::Vector3d rv = aa.angle() * aa.axis();
+  Eigen::VectorXd p = Eigen::VectorXd::Zero(kLensParameters);
+  p.head(kPinholeParameters) << s.fx, s.fy, s.cx, s.cy, rv.x(), rv.y(), rv.z(), s.t.x, s.t.y, s.t.z;
+
+  const int count = static_cast<int>(points.size());
+  const ResidualFunction project_all = [&](const Eigen::VectorXd& q, Eigen::VectorXd& r, Eigen::MatrixXd*) {
+    const PinholeParameters pp = pinhole_of(q);
+    const LensDistortion d = distortion_of(q);
+    r.resize(2 * count);
+    for (int i = 0; i < count; ++i) {
+      const Vec3d& X = points[i].world;
+      const double xc = pp.R[0] * X.x + pp.R[1] * X.y + pp.R[2] * X.z + pp.t.x;
+      const double yc = pp.R[3] * X.x + pp.R[4] * X.y + pp.R[5] * X.z + pp.t.y;
+      const double zc = pp.R[6] * X.x + pp.R[7] * X.y + pp.R[8] * X.z + pp.t.z;
+      const Vec2d u = d.distort({xc / zc, yc / zc});
+      r(2 * i) = (pp.fx * u.x + pp.cx - points[i].pixel.x) / n.image_scale;
+      r(2 * i + 1) = (pp.fy * u.y + pp.cy - points[i].pixel.y) / n.image_scale;
+    }
+  };
+  const ResidualFunction with_jacobian = [&](const Eigen::VectorXd& q, Eigen::VectorXd& r, Eigen::MatrixXd* J) {
+    project_all(q, r, nullptr);
+    if (J) numeric_jacobian(project_all, q, 2 * count, *J);
+  };
+  const LmResult lm = levenberg_marquardt(with_jacobian, 2 * count, p, lm_settings(options));
+  check_fit(lm, kLensParameters, "pinhole_distortion", "projection", options);
+  report.normalization = n;
+  report.iterations = lm.iterations;
+  report.converged = lm.converged;
+  return std::make_unique<LensCamera>(pinhole_of(p), distortion_of(p));
+}
+
+}  // namespace tomorig::calibration::detail
