@@ -106,6 +106,28 @@ std::unique_ptr<CameraModel> fit_dlt(std::span<const PointCorrespondence> points
   return std::make_unique<DltCamera>(denormalise(dlt.normalised, n), n);
 }
 
+namespace {
+
+// fx, fy, cx, cy, rotation vector (3), t (3): the parameters the pinhole-based fits vary.
+std::array<double, 10> pinhole_vector(const PinholeParameters& s) {
+  Eigen::Matrix3d R;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) R(i, j) = s.R[3 * i + j];
+  const Eigen::AngleAxisd aa(R);
+  const Eigen::Vector3d rv = aa.angle() * aa.axis();
+  return {s.fx, s.fy, s.cx, s.cy, rv.x(), rv.y(), rv.z(), s.t.x, s.t.y, s.t.z};
+}
+
+}  // namespace
+
+PinholeStart pinhole_start(std::span<const PointCorrespondence> points, const FitOptions& options) {
+  FitOptions start_options = options;
+  start_options.require_convergence = false;  // the full fit goes on from it
+  FitReport start_report;
+  const auto start = fit_pinhole(points, start_options, start_report);
+  return {pinhole_vector(static_cast<const PinholeCamera&>(*start).parameters()), start_report.normalization};
+}
+
 std::unique_ptr<CameraModel> fit_pinhole(std::span<const PointCorrespondence> points, const FitOptions& options,
                                          FitReport& report) {
   // Started from the DLT, so it needs the DLT's points (11 unknowns), not just its own 10.
@@ -118,13 +140,8 @@ std::unique_ptr<CameraModel> fit_pinhole(std::span<const PointCorrespondence> po
                                 options.camera));
   const PinholeParameters& start = decomposition->parameters;
   // Parameters: fx, fy, cx, cy, rotation vector (3), t (3); residuals in normalised pixels.
-  Eigen::VectorXd p(kPinholeUnknowns);
-  Eigen::Matrix3d R;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) R(i, j) = start.R[3 * i + j];
-  const Eigen::AngleAxisd aa(R);
-  const Eigen::Vector3d rv = aa.angle() * aa.axis();
-  p << start.fx, start.fy, start.cx, start.cy, rv.x(), rv.y(), rv.z(), start.t.x, start.t.y, start.t.z;
+  const std::array<double, 10> v = pinhole_vector(start);
+  Eigen::VectorXd p = Eigen::Map<const Eigen::VectorXd>(v.data(), kPinholeUnknowns);
 
   auto parameters_of = [](const Eigen::VectorXd& q) {
     PinholeParameters pp;

@@ -38,21 +38,11 @@ LensDistortion distortion_of(const Eigen::VectorXd& q) {
 std::unique_ptr<CameraModel> fit_lens(std::span<const PointCorrespondence> points, const FitOptions& options,
                                       FitReport& report) {
   check_points(points, {"pinhole_distortion", kLensParameters, 2, 0}, options);
-  // The start: the pinhole fit (it need not converge itself; the full fit goes on from it).
-  FitOptions start_options = options;
-  start_options.require_convergence = false;
-  FitReport start_report;
-  const auto start = fit_pinhole(points, start_options, start_report);
-  const PinholeParameters& s = static_cast<const PinholeCamera&>(*start).parameters();
-  const Normalization& n = start_report.normalization;
-
-  Eigen::Matrix3d R;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) R(i, j) = s.R[3 * i + j];
-  const Eigen::AngleAxisd aa(R);
-  const Eigen::Vector3d rv = aa.angle() * aa.axis();
+  // The start: the pinhole fit; the full fit goes on from it.
+  const PinholeStart start = pinhole_start(points, options);
+  const Normalization& n = start.normalization;
   Eigen::VectorXd p = Eigen::VectorXd::Zero(kLensParameters);
-  p.head(kPinholeParameters) << s.fx, s.fy, s.cx, s.cy, rv.x(), rv.y(), rv.z(), s.t.x, s.t.y, s.t.z;
+  for (int i = 0; i < kPinholeParameters; ++i) p(i) = start.parameters[static_cast<std::size_t>(i)];
 
   const int count = static_cast<int>(points.size());
   const ResidualFunction project_all = [&](const Eigen::VectorXd& q, Eigen::VectorXd& r, Eigen::MatrixXd*) {

@@ -119,19 +119,10 @@ std::unique_ptr<CameraModel> fit_refractive(std::span<const PointCorrespondence>
   check_points(points, {"refractive", unknowns, 2, 0}, options);
 
   // Start: the pinhole without the window (an apparent camera, close to the real one).
-  FitOptions start_options = options;
-  start_options.require_convergence = false;
-  FitReport start_report;
-  const auto start = fit_pinhole(points, start_options, start_report);
-  const PinholeParameters& s = static_cast<const PinholeCamera&>(*start).parameters();
-  const Normalization& n = start_report.normalization;
-  Eigen::Matrix3d R;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) R(i, j) = s.R[3 * i + j];
-  const Eigen::AngleAxisd aa(R);
-  const Eigen::Vector3d rv = aa.angle() * aa.axis();
+  const PinholeStart start = pinhole_start(points, options);
+  const Normalization& n = start.normalization;
   Eigen::VectorXd full = Eigen::VectorXd::Zero(kAll);
-  full.head(kPinhole) << s.fx, s.fy, s.cx, s.cy, rv.x(), rv.y(), rv.z(), s.t.x, s.t.y, s.t.z;
+  for (int i = 0; i < kPinhole; ++i) full(i) = start.parameters[static_cast<std::size_t>(i)];
   const Frame frame = frame_of(*options.window);
   full(kFaceAt) = options.window->medium_face_mm;
   full(kIndexAt) = options.window->n_medium;

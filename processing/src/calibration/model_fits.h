@@ -1,5 +1,6 @@
 #pragma once
 // The per-model fits behind fit_camera_model(), and the input checks they share.
+#include <array>
 #include <memory>
 #include <optional>
 #include <span>
@@ -56,6 +57,15 @@ std::unique_ptr<CameraModel> fit_dlt(std::span<const PointCorrespondence> points
                                      FitReport& report);
 std::unique_ptr<CameraModel> fit_pinhole(std::span<const PointCorrespondence> points, const FitOptions& options,
                                          FitReport& report);
+// The start of the models built on a pinhole (pinhole_distortion, refractive): a pinhole fit
+// that need not converge itself, as fx, fy, cx, cy, rotation vector (3), t (3), and the
+// points' normalisation.
+struct PinholeStart {
+  std::array<double, 10> parameters{};
+  Normalization normalization;
+};
+PinholeStart pinhole_start(std::span<const PointCorrespondence> points, const FitOptions& options);
+
 std::unique_ptr<CameraModel> fit_lens(std::span<const PointCorrespondence> points, const FitOptions& options,
                                       FitReport& report);
 std::unique_ptr<CameraModel> fit_refractive(std::span<const PointCorrespondence> points, const FitOptions& options,
