@@ -1,5 +1,6 @@
 // The calib-thesis case as a session file: one set per plane, truth alongside.
 #include "tomorig/rig/simulate_calib_target.h"
+#include "tomorig/rig/simulate_session.h"
 
 #include <chrono>
 #include <ctime>
@@ -61,17 +62,7 @@ std::string write_calib_target_session(const sim::CalibTargetOptions& options, c
   truth.flow_name = "traverse";
   truth.flow_parameters = calib_target_truth_json(c);
   truth.seed = options.seed;
-  for (const auto& cam : c.cameras) {
-    const auto& p = cam.pinhole.parameters();
-    storage::TruthCamera t;
-    t.id = cam.id;
-    t.K = cam.pinhole.intrinsics();
-    t.R = p.R;
-    t.t = p.t;
-    t.width = cam.width;
-    t.height = cam.height;
-    truth.cameras.push_back(t);
-  }
+  for (const auto& cam : c.cameras) truth.cameras.push_back(truth_camera_of(cam.id, cam.pinhole, cam.width, cam.height));
   writer.write_truth(truth);
   for (std::size_t k = 0; k < c.planes.size(); ++k) {
     FrameSet set;

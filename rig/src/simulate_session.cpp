@@ -28,15 +28,21 @@ std::string human_bytes(std::uintmax_t bytes) {
 
 }  // namespace
 
-storage::TruthCamera truth_camera_of(const sim::SimulatedCamera& cam) {
+storage::TruthCamera truth_camera_of(const std::string& id, const calibration::PinholeCamera& model, int width,
+                                     int height) {
   storage::TruthCamera t;
-  t.id = cam.spec.id;
-  t.model = cam.model.model_name();
-  t.K = cam.model.intrinsics();
-  t.R = cam.model.parameters().R;
-  t.t = cam.model.parameters().t;
-  t.width = cam.spec.width;
-  t.height = cam.spec.height;
+  t.id = id;
+  t.K = model.intrinsics();
+  t.R = model.parameters().R;
+  t.t = model.parameters().t;
+  t.width = width;
+  t.height = height;
+  return t;
+}
+
+storage::TruthCamera truth_camera_of(const sim::SimulatedCamera& cam) {
+  storage::TruthCamera t = truth_camera_of(cam.spec.id, cam.model, cam.spec.width, cam.spec.height);
+  t.model = cam.model.model_name();  // the rig's cameras are exactly this model
   return t;
 }
 

@@ -1,5 +1,6 @@
 // The spray-thesis case as a session file, truth alongside.
 #include "tomorig/rig/simulate_spray.h"
+#include "tomorig/rig/simulate_session.h"
 
 #include <chrono>
 
@@ -59,17 +60,8 @@ storage::SessionTruth truth_of(const sim::SprayCase& c, const std::string& flow_
   truth.flow_name = flow_name;
   truth.flow_parameters = parameters.dump();
   truth.seed = c.options.seed;
-  for (const sim::SprayCamera& cam : c.cameras) {
-    const auto& p = cam.pinhole.parameters();
-    storage::TruthCamera t;
-    t.id = cam.id;
-    t.K = cam.pinhole.intrinsics();
-    t.R = p.R;
-    t.t = p.t;
-    t.width = cam.width;
-    t.height = cam.height;
-    truth.cameras.push_back(t);
-  }
+  for (const sim::SprayCamera& cam : c.cameras)
+    truth.cameras.push_back(truth_camera_of(cam.id, cam.pinhole, cam.width, cam.height));
   return truth;
 }
 

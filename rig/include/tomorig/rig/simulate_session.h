@@ -30,7 +30,10 @@ struct SimulationSummary {
 // the previous set was written (rendering overlaps writing, so this is the cost per set).
 using SimulationProgress = std::function<void(std::uint64_t done, std::uint64_t total, double set_seconds)>;
 
-// The truth record of a simulated camera (its exact pinhole model and image size).
+// The truth record of a simulated camera: its pinhole's K, R, t and image size (the model name
+// only where the pinhole is the whole camera, as in the simulated rig).
+storage::TruthCamera truth_camera_of(const std::string& id, const calibration::PinholeCamera& model, int width,
+                                     int height);
 storage::TruthCamera truth_camera_of(const sim::SimulatedCamera& cam);
 
 // The simulator options a rig config describes: its [simulation] section, its cameras (all
