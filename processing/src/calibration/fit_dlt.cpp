@@ -120,6 +120,18 @@ std::array<double, 10> pinhole_vector(const PinholeParameters& s) {
 
 }  // namespace
 
+PinholeParameters pinhole_of(const Eigen::VectorXd& q) {
+  PinholeParameters pp;
+  pp.fx = q(0), pp.fy = q(1), pp.cx = q(2), pp.cy = q(3);
+  const Eigen::Vector3d r(q(4), q(5), q(6));
+  const double angle = r.norm();
+  const Eigen::Matrix3d rot = angle > 0 ? Eigen::AngleAxisd(angle, r / angle).toRotationMatrix() : Eigen::Matrix3d::Identity();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) pp.R[3 * i + j] = rot(i, j);
+  pp.t = {q(7), q(8), q(9)};
+  return pp;
+}
+
 PinholeStart pinhole_start(std::span<const PointCorrespondence> points, const FitOptions& options) {
   FitOptions start_options = options;
   start_options.require_convergence = false;  // the full fit goes on from it
@@ -143,21 +155,9 @@ std::unique_ptr<CameraModel> fit_pinhole(std::span<const PointCorrespondence> po
   const std::array<double, 10> v = pinhole_vector(start);
   Eigen::VectorXd p = Eigen::Map<const Eigen::VectorXd>(v.data(), kPinholeUnknowns);
 
-  auto parameters_of = [](const Eigen::VectorXd& q) {
-    PinholeParameters pp;
-    pp.fx = q(0), pp.fy = q(1), pp.cx = q(2), pp.cy = q(3);
-    const Eigen::Vector3d r(q(4), q(5), q(6));
-    const double angle = r.norm();
-    const Eigen::Matrix3d rot =
-        angle > 0 ? Eigen::AngleAxisd(angle, r / angle).toRotationMatrix() : Eigen::Matrix3d::Identity();
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) pp.R[3 * i + j] = rot(i, j);
-    pp.t = {q(7), q(8), q(9)};
-    return pp;
-  };
   const int count = static_cast<int>(points.size());
   const ResidualFunction project_all = [&](const Eigen::VectorXd& q, Eigen::VectorXd& r, Eigen::MatrixXd*) {
-    const PinholeParameters pp = parameters_of(q);
+    const PinholeParameters pp = pinhole_of(q);
     r.resize(2 * count);
     for (int i = 0; i < count; ++i) {
       const Vec3d& X = points[i].world;
@@ -177,7 +177,7 @@ std::unique_ptr<CameraModel> fit_pinhole(std::span<const PointCorrespondence> po
   report.normalization = n;
   report.iterations = lm.iterations;
   report.converged = lm.converged;
-  return std::make_unique<PinholeCamera>(parameters_of(p));
+  return std::make_unique<PinholeCamera>(pinhole_of(p));
 }
 
 }  // namespace tomorig::calibration::detail

@@ -17,18 +17,6 @@ namespace {
 constexpr int kPinholeParameters = 10;  // fx, fy, cx, cy, rotation vector, t
 constexpr int kLensParameters = kPinholeParameters + 5;
 
-PinholeParameters pinhole_of(const Eigen::VectorXd& q) {
-  PinholeParameters pp;
-  pp.fx = q(0), pp.fy = q(1), pp.cx = q(2), pp.cy = q(3);
-  const Eigen::Vector3d r(q(4), q(5), q(6));
-  const double angle = r.norm();
-  const Eigen::Matrix3d rot = angle > 0 ? Eigen::AngleAxisd(angle, r / angle).toRotationMatrix() : Eigen::Matrix3d::Identity();
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) pp.R[3 * i + j] = rot(i, j);
-  pp.t = {q(7), q(8), q(9)};
-  return pp;
-}
-
 LensDistortion distortion_of(const Eigen::VectorXd& q) {
   return {q(10), q(11), q(12), q(13), q(14)};
 }

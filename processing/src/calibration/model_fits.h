@@ -11,6 +11,7 @@
 #include "polynomial_maps.h"
 #include "tomorig/processing/calibration/camera_model.h"
 #include "tomorig/processing/calibration/fit_types.h"
+#include "tomorig/processing/calibration/pinhole_camera.h"
 #include "tomorig/processing/calibration/polynomial_camera.h"
 
 namespace tomorig::calibration::detail {
@@ -65,6 +66,8 @@ struct PinholeStart {
   Normalization normalization;
 };
 PinholeStart pinhole_start(std::span<const PointCorrespondence> points, const FitOptions& options);
+// The inverse of that vector's first 10 entries (the rotation vector back to a matrix).
+PinholeParameters pinhole_of(const Eigen::VectorXd& q);
 
 std::unique_ptr<CameraModel> fit_lens(std::span<const PointCorrespondence> points, const FitOptions& options,
                                       FitReport& report);
