@@ -143,18 +143,6 @@ pipeline::SessionSelfcalOptions options_of(const SelfcalArgs& args) {
 
 nlohmann::json report_json(const SelfcalArgs& args, const pipeline::SessionSelfcalReport& s) {
   const calibration::SelfCalibrationResult& r = s.result;
-  // Disparities near the first pass's search radius: larger ones were cut off by it, so the
-  // "before" figures understate the misalignment and the correction may miss it (issue 18).
-  if (!r.passes.empty())
-    for (std::size_t c = 0; c < r.before().cameras.size(); ++c) {
-      const double radius = r.before().search_radius_px, largest = r.before().cameras[c].volume.max_px;
-      if (largest >= 0.75 * radius)
-        fmt::print(stderr,
-                   "warning: camera {}: sub-volume disparities before correction reach {:.2f} px, close to the "
-                   "{:.2f} px search radius; larger misalignments are cut off by it and the 'before' figures "
-                   "understate them: rerun with --search-radius {:.3g}\n",
-                   c, largest, radius, std::min(20.0, 2 * radius));
-    }
   nlohmann::json cams = nlohmann::json::array();
   for (std::size_t c = 0; c < r.models.size(); ++c) {
     nlohmann::json j = {{"camera", c},
