@@ -1,11 +1,12 @@
 // Reading the calibration file: every value is checked, and a problem names the camera and
 // the key, so that a hand-edited or truncated file is refused before it can mis-project.
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include <fmt/core.h>
-#include <toml++/toml.h>
 
+#include "tomorig/config/toml_document.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/calibration/calibration_file.h"
 #include "tomorig/processing/calibration/dlt_camera.h"
@@ -27,51 +28,51 @@ class CameraReader {
     throw bad_input(fmt::format("{}: {} {}", where_, key, problem));
   }
 
-  const toml::table& table(const toml::table& parent, const std::string& prefix, const char* key) const {
-    const toml::table* t = parent[key].as_table();
-    if (!t) fail(prefix + key, "is missing (or is not a table)");
-    return *t;
+  config::TomlNode table(config::TomlNode parent, const std::string& prefix, const char* key) const {
+    const config::TomlNode t = parent[key];
+    if (!t.is_table()) fail(prefix + key, "is missing (or is not a table)");
+    return t;
   }
 
-  double number(const toml::table& t, const std::string& prefix, const char* key) const {
-    return number_of(t[key].node(), prefix + key);
+  double number(config::TomlNode t, const std::string& prefix, const char* key) const {
+    return number_of(t[key], prefix + key);
   }
 
-  std::int64_t integer(const toml::table& t, const std::string& prefix, const char* key) const {
-    const auto v = t[key].value<std::int64_t>();
+  std::int64_t integer(config::TomlNode t, const std::string& prefix, const char* key) const {
+    const auto v = t[key].as_integer();
     if (!t[key].is_integer() || !v) fail(prefix + key, t[key] ? "must be an integer" : "is missing");
     return *v;
   }
 
-  bool boolean(const toml::table& t, const std::string& prefix, const char* key) const {
-    const auto v = t[key].value<bool>();
+  bool boolean(config::TomlNode t, const std::string& prefix, const char* key) const {
+    const auto v = t[key].as_bool();
     if (!v) fail(prefix + key, t[key] ? "must be true or false" : "is missing");
     return *v;
   }
 
-  std::string string(const toml::table& t, const std::string& prefix, const char* key) const {
-    const auto v = t[key].value<std::string>();
+  std::string string(config::TomlNode t, const std::string& prefix, const char* key) const {
+    const auto v = t[key].as_string();
     if (!v) fail(prefix + key, t[key] ? "must be a string" : "is missing");
     return *v;
   }
 
   // An array of exactly `size` finite numbers (size < 0: any length >= 1).
-  std::vector<double> numbers(const toml::table& t, const std::string& prefix, const char* key, int size) const {
+  std::vector<double> numbers(config::TomlNode t, const std::string& prefix, const char* key, int size) const {
     const std::string name = prefix + key;
-    const toml::array* a = t[key].as_array();
-    if (!a) fail(name, t[key] ? "must be an array of numbers" : "is missing");
-    if (size >= 0 && static_cast<int>(a->size()) != size)
-      fail(name, fmt::format("has {} values, expected {}", a->size(), size));
+    const config::TomlNode a = t[key];
+    if (!a.is_array()) fail(name, a ? "must be an array of numbers" : "is missing");
+    if (size >= 0 && static_cast<int>(a.size()) != size)
+      fail(name, fmt::format("has {} values, expected {}", a.size(), size));
     std::vector<double> out;
-    for (std::size_t k = 0; k < a->size(); ++k) out.push_back(number_of(a->get(k), fmt::format("{}[{}]", name, k)));
+    for (std::size_t k = 0; k < a.size(); ++k) out.push_back(number_of(a[k], fmt::format("{}[{}]", name, k)));
     return out;
   }
 
  private:
-  double number_of(const toml::node* node, const std::string& name) const {
+  double number_of(config::TomlNode node, const std::string& name) const {
     if (!node) fail(name, "is missing");
-    if (!node->is_number()) fail(name, "must be a number");
-    const double v = node->value<double>().value_or(std::nan(""));
+    if (!node.is_number()) fail(name, "must be a number");
+    const double v = node.as_double().value_or(std::nan(""));
     if (!std::isfinite(v)) fail(name, fmt::format("is {}: every coefficient must be finite", v));
     return v;
   }
@@ -79,8 +80,8 @@ class CameraReader {
   std::string where_;
 };
 
-Normalization read_normalization(const CameraReader& r, const toml::table& cam) {
-  const toml::table& t = r.table(cam, "", "normalization");
+Normalization read_normalization(const CameraReader& r, config::TomlNode cam) {
+  const config::TomlNode t = r.table(cam, "", "normalization");
   const std::string p = "normalization.";
   Normalization n;
   const auto wc = r.numbers(t, p, "world_centre", 3);
@@ -94,8 +95,8 @@ Normalization read_normalization(const CameraReader& r, const toml::table& cam) 
   return n;
 }
 
-FitReport read_report(const CameraReader& r, const toml::table& cam, const std::string& model, int id) {
-  const toml::table& t = r.table(cam, "", "fit");
+FitReport read_report(const CameraReader& r, config::TomlNode cam, const std::string& model, int id) {
+  const config::TomlNode t = r.table(cam, "", "fit");
   const std::string p = "fit.";
   FitReport rep;
   rep.model = model;
@@ -115,7 +116,7 @@ FitReport read_report(const CameraReader& r, const toml::table& cam, const std::
   return rep;
 }
 
-int newton_steps(const CameraReader& r, const toml::table& c, const std::string& p) {
+int newton_steps(const CameraReader& r, config::TomlNode c, const std::string& p) {
   const auto steps = r.integer(c, p, "newton_steps");
   if (steps < 0 || steps > 50) r.fail(p + "newton_steps", fmt::format("= {} must be in [0, 50]", steps));
   return static_cast<int>(steps);
@@ -132,9 +133,9 @@ std::shared_ptr<const CameraModel> construct(const CameraReader& r, Make make) {
   }
 }
 
-std::shared_ptr<const CameraModel> read_model(const CameraReader& r, const toml::table& cam, const std::string& model,
+std::shared_ptr<const CameraModel> read_model(const CameraReader& r, config::TomlNode cam, const std::string& model,
                                               const Normalization& n) {
-  const toml::table& c = r.table(cam, "", "coefficients");
+  const config::TomlNode c = r.table(cam, "", "coefficients");
   const std::string p = "coefficients.";
   if (model == "pinhole" || model == "pinhole_distortion" || model == "refractive") {
     PinholeParameters pp;
@@ -176,15 +177,15 @@ std::shared_ptr<const CameraModel> read_model(const CameraReader& r, const toml:
     return construct(r, [&] { return std::make_shared<PolynomialCamera>(kind, n, forward, inverse, steps); });
   }
   if (model == "twoplane") {
-    const toml::array* planes = c["planes"].as_array();
-    if (!planes || planes->size() < 2) r.fail(p + "planes", "must be an array of at least 2 plane tables");
+    const config::TomlNode planes = c["planes"];
+    if (!planes.is_array() || planes.size() < 2) r.fail(p + "planes", "must be an array of at least 2 plane tables");
     std::vector<TwoPlaneMapping> mappings;
-    for (std::size_t k = 0; k < planes->size(); ++k) {
-      const toml::table* t = planes->get(k)->as_table();
+    for (std::size_t k = 0; k < planes.size(); ++k) {
+      const config::TomlNode t = planes[k];
       const std::string pk = fmt::format("{}planes[{}].", p, k);
-      if (!t) r.fail(pk.substr(0, pk.size() - 1), "must be a table");
-      mappings.push_back({r.number(*t, pk, "z"), r.numbers(*t, pk, "to_world", TwoPlaneCamera::kCoefficientsPerMapping),
-                          r.numbers(*t, pk, "to_image", TwoPlaneCamera::kCoefficientsPerMapping)});
+      if (!t.is_table()) r.fail(pk.substr(0, pk.size() - 1), "must be a table");
+      mappings.push_back({r.number(t, pk, "z"), r.numbers(t, pk, "to_world", TwoPlaneCamera::kCoefficientsPerMapping),
+                          r.numbers(t, pk, "to_image", TwoPlaneCamera::kCoefficientsPerMapping)});
     }
     const int steps = newton_steps(r, c, p);
     return construct(r, [&] { return std::make_shared<TwoPlaneCamera>(n, mappings, steps); });
@@ -195,39 +196,39 @@ std::shared_ptr<const CameraModel> read_model(const CameraReader& r, const toml:
 }  // namespace
 
 std::vector<CameraCalibration> load_calibration(const std::filesystem::path& path) {
-  toml::table root;
+  std::optional<config::TomlDocument> doc;
   try {
-    root = toml::parse_file(path.string());
-  } catch (const toml::parse_error& e) {
+    doc = config::TomlDocument::parse_file(path);
+  } catch (const config::TomlSyntaxError& e) {
     if (!std::filesystem::exists(path))
       throw bad_input(fmt::format("calibration file {} does not exist", path.string()));
-    throw bad_input(fmt::format("calibration file {}: line {}: {}", path.string(), e.source().begin.line,
-                                e.description()));
+    throw bad_input(fmt::format("calibration file {}: line {}: {}", path.string(), e.line(), e.description()));
   }
+  const config::TomlNode root = doc->root();
   const std::string file = path.string();
-  if (root["format"].value<std::string>() != "tomorig-calibration")
+  if (root["format"].as_string() != "tomorig-calibration")
     throw bad_input(fmt::format("{}: not a tomorig calibration file (format = \"tomorig-calibration\" is missing)", file));
-  if (root["version"].value<std::int64_t>() != 1)
+  if (root["version"].as_integer() != 1)
     throw bad_input(fmt::format("{}: unsupported version (this tomorig reads version = 1)", file));
-  const toml::array* cameras = root["camera"].as_array();
-  if (!cameras || cameras->empty()) throw bad_input(fmt::format("{}: no [[camera]] entries", file));
+  const config::TomlNode cameras = root["camera"];
+  if (!cameras.is_array() || cameras.size() == 0) throw bad_input(fmt::format("{}: no [[camera]] entries", file));
 
   std::vector<CameraCalibration> out;
-  for (std::size_t k = 0; k < cameras->size(); ++k) {
-    const toml::table* cam = cameras->get(k)->as_table();
-    if (!cam) throw bad_input(fmt::format("{}: camera entry {} is not a table", file, k));
+  for (std::size_t k = 0; k < cameras.size(); ++k) {
+    const config::TomlNode cam = cameras[k];
+    if (!cam.is_table()) throw bad_input(fmt::format("{}: camera entry {} is not a table", file, k));
     const CameraReader entry(fmt::format("{}: camera entry {}", file, k));
     CameraCalibration c;
-    c.id = static_cast<int>(entry.integer(*cam, "", "id"));
+    c.id = static_cast<int>(entry.integer(cam, "", "id"));
     for (const auto& seen : out)
       if (seen.id == c.id) entry.fail("id", fmt::format("= {} is used by two cameras", c.id));
     const CameraReader r(fmt::format("{}: camera {}", file, c.id));
-    c.image_size = {static_cast<int>(r.integer(*cam, "", "image_width")), static_cast<int>(r.integer(*cam, "", "image_height"))};
+    c.image_size = {static_cast<int>(r.integer(cam, "", "image_width")), static_cast<int>(r.integer(cam, "", "image_height"))};
     if (c.image_size.width <= 0 || c.image_size.height <= 0) r.fail("image_width/image_height", "must be > 0");
-    const std::string model = r.string(*cam, "", "model");
-    const Normalization n = read_normalization(r, *cam);
-    c.model = read_model(r, *cam, model, n);
-    c.report = read_report(r, *cam, model, c.id);
+    const std::string model = r.string(cam, "", "model");
+    const Normalization n = read_normalization(r, cam);
+    c.model = read_model(r, cam, model, n);
+    c.report = read_report(r, cam, model, c.id);
     c.report.normalization = n;
     out.push_back(std::move(c));
   }

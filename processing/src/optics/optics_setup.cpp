@@ -2,12 +2,13 @@
 
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <set>
 #include <sstream>
 
 #include <fmt/core.h>
-#include <toml++/toml.h>
 
+#include "tomorig/config/toml_document.h"
 #include "tomorig/core/error.h"
 
 namespace tomorig::optics {
@@ -15,68 +16,67 @@ namespace {
 
 class Reader {
  public:
-  Reader(const std::string& source, std::string path, const toml::table& table)
+  Reader(const std::string& source, std::string path, config::TomlNode table)
       : source_(source), path_(std::move(path)), table_(table) {}
 
-  [[noreturn]] void fail(const std::string& key, const toml::node* node, const std::string& problem) const {
-    const auto line = node ? node->source().begin.line : table_.source().begin.line;
+  [[noreturn]] void fail(const std::string& key, config::TomlNode node, const std::string& problem) const {
+    const int line = node ? node.line() : table_.line();
     const std::string where = path_.empty() ? key : (key.empty() ? path_ : path_ + "." + key);
     throw bad_input(fmt::format("{}: {} (line {}): {}", source_, where, line, problem));
   }
   void only(const std::set<std::string>& allowed) const {
-    for (const auto& [key, value] : table_) {
-      if (allowed.count(std::string(key.str()))) continue;
+    for (const auto& [key, value] : table_.entries()) {
+      if (allowed.count(key)) continue;
       std::string list;
       for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      fail(std::string(key.str()), &value, "is not a key here; allowed: " + list);
+      fail(key, value, "is not a key here; allowed: " + list);
     }
   }
   bool has(const char* key) const { return table_.contains(key); }
   double number(const char* key) const {
-    const toml::node* n = table_.get(key);
-    if (!n) fail(key, nullptr, "is required");
-    return as_number(key, *n);
+    const config::TomlNode n = table_[key];
+    if (!n) fail(key, {}, "is required");
+    return as_number(key, n);
   }
-  double as_number(const std::string& key, const toml::node& n) const {
-    if (!n.is_number()) fail(key, &n, "must be a number");
-    const double v = n.is_integer() ? static_cast<double>(*n.value<std::int64_t>()) : *n.value<double>();
-    if (!std::isfinite(v)) fail(key, &n, "must be a finite number");
+  double as_number(const std::string& key, config::TomlNode n) const {
+    if (!n.is_number()) fail(key, n, "must be a number");
+    const double v = n.is_integer() ? static_cast<double>(*n.as_integer()) : *n.as_double();
+    if (!std::isfinite(v)) fail(key, n, "must be a finite number");
     return v;
   }
   std::string string(const char* key) const {
-    const toml::node* n = table_.get(key);
-    if (!n) fail(key, nullptr, "is required");
-    if (!n->is_string()) fail(key, n, "must be a string");
-    return *n->value<std::string>();
+    const config::TomlNode n = table_[key];
+    if (!n) fail(key, {}, "is required");
+    if (!n.is_string()) fail(key, n, "must be a string");
+    return *n.as_string();
   }
   std::vector<double> numbers(const char* key) const {
-    const toml::node* n = table_.get(key);
-    if (!n) fail(key, nullptr, "is required");
-    const toml::array* a = n->as_array();
-    if (!a || a->empty()) fail(key, n, "must be a non-empty array of numbers");
+    const config::TomlNode n = table_[key];
+    if (!n) fail(key, {}, "is required");
+    if (!n.is_array() || n.size() == 0) fail(key, n, "must be a non-empty array of numbers");
     std::vector<double> out;
-    for (std::size_t i = 0; i < a->size(); ++i) out.push_back(as_number(fmt::format("{}[{}]", key, i), (*a)[i]));
+    for (std::size_t i = 0; i < n.size(); ++i) out.push_back(as_number(fmt::format("{}[{}]", key, i), n[i]));
     return out;
   }
-  const toml::node* node(const char* key) const { return table_.get(key); }
+  config::TomlNode node(const char* key) const { return table_[key]; }
 
  private:
   const std::string& source_;
   std::string path_;
-  const toml::table& table_;
+  config::TomlNode table_;
 };
 
 }  // namespace
 
 VisibilitySetup parse_optics_setup(std::string_view toml_text, const std::string& source) {
-  toml::table root;
+  std::optional<config::TomlDocument> doc;
   try {
-    root = toml::parse(toml_text, source);
-  } catch (const toml::parse_error& e) {
-    throw bad_input(fmt::format("{}: line {}: {}", source, e.source().begin.line, e.description()));
+    doc = config::TomlDocument::parse(toml_text, source);
+  } catch (const config::TomlSyntaxError& e) {
+    throw bad_input(fmt::format("{}: line {}: {}", source, e.line(), e.description()));
   }
   VisibilitySetup setup;
-  const Reader top(source, "", root);
+  const Reader top(source, "", doc->root());
   top.only({"liquid", "led", "cameras", "d_max_um"});
   if (top.has("liquid")) {
     try {
@@ -86,9 +86,9 @@ VisibilitySetup parse_optics_setup(std::string_view toml_text, const std::string
     }
   }
   if (top.has("d_max_um")) setup.d_max_um = top.number("d_max_um");
-  if (const toml::node* led = top.node("led")) {
-    if (!led->is_table()) top.fail("led", led, "must be a table ([led])");
-    const Reader r(source, "led", *led->as_table());
+  if (const config::TomlNode led = top.node("led")) {
+    if (!led.is_table()) top.fail("led", led, "must be a table ([led])");
+    const Reader r(source, "led", led);
     r.only({"peak_nm", "fwhm_nm", "samples"});
     if (r.has("peak_nm")) setup.spectrum.peak_nm = r.number("peak_nm");
     if (r.has("fwhm_nm")) setup.spectrum.fwhm_nm = r.number("fwhm_nm");
@@ -96,24 +96,23 @@ VisibilitySetup parse_optics_setup(std::string_view toml_text, const std::string
     try {
       setup.spectrum.validate();
     } catch (const Error& e) {
-      r.fail("", nullptr, e.what());
+      r.fail("", {}, e.what());
     }
   }
-  const toml::node* cams = top.node("cameras");
-  if (!cams || !cams->is_array_of_tables() || cams->as_array()->empty())
+  const config::TomlNode cams = top.node("cameras");
+  if (!cams || !cams.is_array_of_tables() || cams.size() == 0)
     throw bad_input(fmt::format("{}: no [[cameras]]: give each camera's id, f_number, magnification, noise (or "
                                 "threshold), z_mm and chi_um",
                                 source));
-  const toml::array& list = *cams->as_array();
-  for (std::size_t i = 0; i < list.size(); ++i) {
-    const Reader r(source, fmt::format("cameras[{}]", i), *list[i].as_table());
+  for (std::size_t i = 0; i < cams.size(); ++i) {
+    const Reader r(source, fmt::format("cameras[{}]", i), cams[i]);
     r.only({"id", "f_number", "magnification", "noise", "threshold", "z_mm", "chi_um"});
     CameraOptics c;
     c.id = r.has("id") ? r.string("id") : fmt::format("camera {}", i + 1);
     c.f_number = r.number("f_number");
     c.magnification = r.number("magnification");
     if (r.has("noise") == r.has("threshold"))
-      r.fail("", nullptr, "give exactly one of noise (sigma of the flat-fielded bright field) or threshold (1 - 2 sigma)");
+      r.fail("", {}, "give exactly one of noise (sigma of the flat-fielded bright field) or threshold (1 - 2 sigma)");
     c.noise_sigma = r.has("noise") ? r.number("noise") : 0.5 * (1.0 - r.number("threshold"));
     const std::vector<double> z = r.numbers("z_mm"), chi = r.numbers("chi_um");
     if (z.size() != chi.size())
@@ -125,7 +124,7 @@ VisibilitySetup parse_optics_setup(std::string_view toml_text, const std::string
       one.cameras = {setup.cameras.back()};
       one.validate();
     } catch (const Error& e) {
-      r.fail("", nullptr, e.what());
+      r.fail("", {}, e.what());
     }
   }
   try {

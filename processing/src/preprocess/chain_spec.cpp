@@ -12,8 +12,8 @@
 #include <utility>
 
 #include <fmt/core.h>
-#include <toml++/toml.h>
 
+#include "tomorig/config/toml_document.h"
 #include "tomorig/core/error.h"
 
 namespace tomorig::preprocess {
@@ -65,50 +65,50 @@ std::string joined(const std::set<std::string>& keys) {
 // Reads one step table; every failure names "<source>: <path>.<key> (line N)".
 class StepReader {
  public:
-  StepReader(const std::string& source, std::string path, const toml::table& table)
+  StepReader(const std::string& source, std::string path, config::TomlNode table)
       : source_(source), path_(std::move(path)), table_(table) {}
 
-  [[noreturn]] void fail(const std::string& key, const toml::node* node, const std::string& problem) const {
-    const auto line = node ? node->source().begin.line : table_.source().begin.line;
+  [[noreturn]] void fail(const std::string& key, config::TomlNode node, const std::string& problem) const {
+    const int line = node ? node.line() : table_.line();
     throw bad_input(fmt::format("{}: {}{} (line {}): {}", source_, path_, key.empty() ? "" : "." + key, line, problem));
   }
 
   bool has(const char* key) const { return table_.contains(key); }
 
   double number(const char* key) const {
-    const toml::node* n = table_.get(key);
-    if (!n->is_number()) fail(key, n, "must be a number");
-    const double v = n->is_integer() ? static_cast<double>(*n->value<std::int64_t>()) : *n->value<double>();
+    const config::TomlNode n = table_[key];
+    if (!n.is_number()) fail(key, n, "must be a number");
+    const double v = n.is_integer() ? static_cast<double>(*n.as_integer()) : *n.as_double();
     if (!std::isfinite(v)) fail(key, n, "must be a finite number");
     return v;
   }
   int integer(const char* key) const {
-    const toml::node* n = table_.get(key);
-    if (!n->is_integer()) fail(key, n, "must be an integer");
-    const auto v = *n->value<std::int64_t>();
+    const config::TomlNode n = table_[key];
+    if (!n.is_integer()) fail(key, n, "must be an integer");
+    const auto v = *n.as_integer();
     if (v < -1000000 || v > 1000000) fail(key, n, "is out of range");
     return static_cast<int>(v);
   }
   std::string string(const char* key) const {
-    const toml::node* n = table_.get(key);
-    if (!n->is_string()) fail(key, n, "must be a string");
-    return *n->value<std::string>();
+    const config::TomlNode n = table_[key];
+    if (!n.is_string()) fail(key, n, "must be a string");
+    return *n.as_string();
   }
   bool boolean(const char* key) const {
-    const toml::node* n = table_.get(key);
-    if (!n->is_boolean()) fail(key, n, "must be true or false");
-    return *n->value<bool>();
+    const config::TomlNode n = table_[key];
+    if (!n.is_boolean()) fail(key, n, "must be true or false");
+    return *n.as_bool();
   }
-  const toml::node* node(const char* key) const { return table_.get(key); }
+  config::TomlNode node(const char* key) const { return table_[key]; }
 
  private:
   const std::string& source_;
   std::string path_;
-  const toml::table& table_;
+  config::TomlNode table_;
 };
 
-Step read_step(const StepReader& r, const toml::table& table) {
-  if (!r.has("kind")) r.fail("kind", nullptr, "is missing; one of: " + kind_list());
+Step read_step(const StepReader& r, config::TomlNode table) {
+  if (!r.has("kind")) r.fail("kind", {}, "is missing; one of: " + kind_list());
   const std::string kind_name = r.string("kind");
   std::optional<StepKind> kind;
   for (const auto& [k, name] : kKindNames)
@@ -116,10 +116,9 @@ Step read_step(const StepReader& r, const toml::table& table) {
   if (!kind) r.fail("kind", r.node("kind"), fmt::format("unknown step '{}'; one of: {}", kind_name, kind_list()));
 
   const auto allowed = allowed_keys(*kind);
-  for (const auto& [key, value] : table) {
-    const std::string k(key.str());
+  for (const auto& [k, value] : table.entries()) {
     if (k != "kind" && !allowed.count(k))
-      r.fail(k, &value, fmt::format("is not a parameter of '{}'; allowed: {}", kind_name, joined(allowed)));
+      r.fail(k, value, fmt::format("is not a parameter of '{}'; allowed: {}", kind_name, joined(allowed)));
   }
 
   Step step;
@@ -127,7 +126,7 @@ Step read_step(const StepReader& r, const toml::table& table) {
   switch (*kind) {
     case StepKind::subtract_dark:
       if (r.has("file") == r.has("level"))
-        r.fail("", nullptr, "subtract_dark needs exactly one of 'file' (a session of dark frames) or 'level' (counts)");
+        r.fail("", {}, "subtract_dark needs exactly one of 'file' (a session of dark frames) or 'level' (counts)");
       if (r.has("file")) step.file = r.string("file");
       if (r.has("level")) step.level = r.number("level");
       break;
@@ -151,7 +150,7 @@ Step read_step(const StepReader& r, const toml::table& table) {
       if (r.has("target")) step.target = r.number("target");
       break;
     case StepKind::flat_field:
-      if (!r.has("file")) r.fail("file", nullptr, "is missing: the session file of bright-field frames");
+      if (!r.has("file")) r.fail("file", {}, "is missing: the session file of bright-field frames");
       step.file = r.string("file");
       break;
     case StepKind::invert:
@@ -159,7 +158,7 @@ Step read_step(const StepReader& r, const toml::table& table) {
       break;
     case StepKind::clip:
       if (r.has("level") == r.has("sigmas"))
-        r.fail("", nullptr, "clip needs exactly one of 'level' (counts) or 'sigmas' (k of the background sigma)");
+        r.fail("", {}, "clip needs exactly one of 'level' (counts) or 'sigmas' (k of the background sigma)");
       if (r.has("level")) step.level = r.number("level");
       if (r.has("sigmas")) {
         step.use_sigmas = true;
@@ -228,37 +227,38 @@ void validate(const Step& step, std::size_t index) {
 }
 
 ChainSpec parse_chain(std::string_view toml_text, const std::string& source) {
-  toml::table root;
+  std::optional<config::TomlDocument> doc;
   try {
-    root = toml::parse(toml_text, source);
-  } catch (const toml::parse_error& e) {
-    throw bad_input(fmt::format("{}: line {}: {}", source, e.source().begin.line, e.description()));
+    doc = config::TomlDocument::parse(toml_text, source);
+  } catch (const config::TomlSyntaxError& e) {
+    throw bad_input(fmt::format("{}: line {}: {}", source, e.line(), e.description()));
   }
-  const auto top_fail = [&](const std::string& key, const toml::node& n, const std::string& problem) {
-    throw bad_input(fmt::format("{}: {} (line {}): {}", source, key, n.source().begin.line, problem));
+  const auto top_fail = [&](const std::string& key, config::TomlNode n, const std::string& problem) {
+    throw bad_input(fmt::format("{}: {} (line {}): {}", source, key, n.line(), problem));
   };
-  for (const auto& [key, value] : root)
-    if (key.str() != "preprocess") top_fail(std::string(key.str()), value, "is not allowed; the file holds [[preprocess.steps]] only");
-  const toml::table* pre = root["preprocess"].as_table();
-  if (!pre) throw bad_input(fmt::format("{}: no [[preprocess.steps]]: give at least one step", source));
-  for (const auto& [key, value] : *pre)
-    if (key.str() != "steps")
-      top_fail("preprocess." + std::string(key.str()), value, "is not allowed; only preprocess.steps");
-  const toml::array* steps = (*pre)["steps"].as_array();
-  if (!steps || steps->empty()) throw bad_input(fmt::format("{}: preprocess.steps must be a non-empty array of tables ([[preprocess.steps]])", source));
+  const config::TomlNode root = doc->root();
+  for (const auto& [key, value] : root.entries())
+    if (key != "preprocess") top_fail(key, value, "is not allowed; the file holds [[preprocess.steps]] only");
+  const config::TomlNode pre = root["preprocess"];
+  if (!pre.is_table()) throw bad_input(fmt::format("{}: no [[preprocess.steps]]: give at least one step", source));
+  for (const auto& [key, value] : pre.entries())
+    if (key != "steps")
+      top_fail("preprocess." + key, value, "is not allowed; only preprocess.steps");
+  const config::TomlNode steps = pre["steps"];
+  if (!steps.is_array() || steps.size() == 0) throw bad_input(fmt::format("{}: preprocess.steps must be a non-empty array of tables ([[preprocess.steps]])", source));
 
   ChainSpec spec;
-  for (std::size_t i = 0; i < steps->size(); ++i) {
+  for (std::size_t i = 0; i < steps.size(); ++i) {
     const std::string path = fmt::format("preprocess.steps[{}]", i);
-    const toml::table* t = (*steps)[i].as_table();
-    if (!t) top_fail(path, (*steps)[i], "must be a table with a 'kind'");
-    const StepReader reader(source, path, *t);
-    Step step = read_step(reader, *t);
+    const config::TomlNode t = steps[i];
+    if (!t.is_table()) top_fail(path, t, "must be a table with a 'kind'");
+    const StepReader reader(source, path, t);
+    Step step = read_step(reader, t);
     try {
       validate(step, i);
     } catch (const Error& e) {
       // Re-say the problem with the key path and line of the file.
-      throw bad_input(fmt::format("{}: {} (line {}): {}", source, path, t->source().begin.line, e.what()));
+      throw bad_input(fmt::format("{}: {} (line {}): {}", source, path, t.line(), e.what()));
     }
     spec.steps.push_back(std::move(step));
   }
