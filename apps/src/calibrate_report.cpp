@@ -9,22 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "tomorig/core/error.h"
-#include "tomorig/processing/calibration/fit_camera_model.h"
 
 namespace tomorig::app {
-
-std::vector<PlaneResidual> plane_residuals(const calibration::CameraModel& model,
-                                           std::span<const calibration::PointCorrespondence> points) {
-  std::map<double, std::vector<calibration::PointCorrespondence>> by_z;
-  for (const auto& p : points) by_z[p.world.z].push_back(p);
-  std::vector<PlaneResidual> planes;
-  for (const auto& [z, plane_points] : by_z) {
-    calibration::FitReport report;
-    calibration::measure_residuals(model, plane_points, report);
-    planes.push_back({z, static_cast<int>(plane_points.size()), report.forward_mean_px, report.reverse_mean_um});
-  }
-  return planes;
-}
 
 void print_report(const std::vector<ModelResult>& results, const std::string& stored, const std::string& out) {
   fmt::print("{:>6}  {:<10} {:>7} {:>6} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10}\n", "camera", "model", "points",
@@ -51,64 +37,6 @@ void print_report(const std::vector<ModelResult>& results, const std::string& st
     fmt::print("nothing written\n");
   else if (!out.empty())
     fmt::print("wrote {} (model {} for every camera)\n", out, stored);
-}
-
-CrossValidation cross_validate(const std::string& model, std::span<const calibration::PointCorrespondence> points,
-                               calibration::ImageSize size, const calibration::FitOptions& options, int camera) {
-  CrossValidation cv;
-  cv.camera = camera;
-  cv.model = model;
-  std::map<double, std::vector<calibration::PointCorrespondence>> by_z;
-  for (const auto& p : points) by_z[p.world.z].push_back(p);
-  double squares = 0;
-  for (const auto& [z, left_out] : by_z) {
-    std::vector<calibration::PointCorrespondence> kept;
-    for (const auto& p : points)
-      if (p.world.z != z) kept.push_back(p);
-    try {
-      calibration::FitReport report;
-      const auto fitted = calibration::fit_camera_model(model, kept, size, options, report);
-      for (const auto& p : left_out) {
-        const Vec2d u = fitted->project(p.world);
-        const double d = std::hypot(u.x - p.pixel.x, u.y - p.pixel.y);
-        squares += d * d;
-        cv.max_px = std::max(cv.max_px, d);
-        ++cv.points;
-      }
-      ++cv.folds;
-    } catch (const Error& e) {
-      cv.error = fmt::format("without plane z = {} mm: {}", z, e.what());
-      return cv;
-    }
-  }
-  cv.rms_px = cv.points > 0 ? std::sqrt(squares / cv.points) : 0;
-  return cv;
-}
-
-AutoChoice choose_model(const std::vector<CrossValidation>& results, const std::vector<std::string>& models) {
-  std::vector<std::pair<double, std::string>> ranked;
-  for (const std::string& model : models) {
-    double sum = 0;
-    int cameras = 0;
-    bool usable = true;
-    for (const CrossValidation& cv : results)
-      if (cv.model == model) {
-        usable = usable && cv.error.empty();
-        sum += cv.rms_px;
-        ++cameras;
-      }
-    if (usable && cameras > 0) ranked.push_back({sum / cameras, model});
-  }
-  if (ranked.empty())
-    throw bad_input("--models auto: no model could be cross-validated on every camera (each needs its planes; see the "
-                    "reasons above); list the models with --models");
-  std::sort(ranked.begin(), ranked.end());
-  AutoChoice choice{ranked.front().second, {}};
-  choice.reason = fmt::format("stored {}: the lowest leave-one-plane-out RMS, {:.4g} px averaged over the cameras", choice.model,
-                              ranked.front().first);
-  if (ranked.size() > 1)
-    choice.reason += fmt::format(" (next: {} {:.4g} px)", ranked[1].second, ranked[1].first);
-  return choice;
 }
 
 void print_cross_validation(const std::vector<CrossValidation>& results) {

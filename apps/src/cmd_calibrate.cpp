@@ -26,8 +26,8 @@
 #include "tomorig/pipeline/correspondence_csv.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/calibration/calibration_file.h"
+#include "tomorig/processing/calibration/calibrate_cameras.h"
 #include "tomorig/processing/calibration/fit_camera_model.h"
-#include "tomorig/processing/calibration/traverse_correction.h"
 #include "tomorig/storage/output_path.h"
 
 namespace tomorig::app {
@@ -325,7 +325,7 @@ void run_check(const CalibrateArgs& args) {
     calibration::measure_residuals(*found->model, table.cameras[i], report);
     report.camera = fmt::format("camera {}", i);
     report.retry.clear();
-    results.push_back({static_cast<int>(i), report, plane_residuals(*found->model, table.cameras[i])});
+    results.push_back({static_cast<int>(i), report, calibration::plane_residuals(*found->model, table.cameras[i])});
   }
   if (args.json) {
     fmt::print("{}\n", nlohmann::json{{"check", args.check}, {"points", args.points}, {"results", report_json(results)}}.dump(2));
@@ -340,135 +340,48 @@ void run(const CalibrateArgs& args) {
   if (args.out.empty()) throw bad_input("-o,--out CALIB.toml is required: the calibration file to write");
   // Before any fit: an existing calibration is never replaced without --overwrite.
   storage::check_output_path(args.out, args.overwrite, "calibration");
-  const bool automatic = args.models == "auto";
-  std::vector<std::string> models = automatic ? calibration::camera_model_names() : parse_models(args.models);
-  if (automatic && args.window_thickness_mm >= 0) models.push_back("refractive");
-  if (automatic && !args.store.empty()) throw bad_input("--models auto chooses the stored model; --store does not go with it");
-  std::string stored = args.store.empty() ? models.back() : args.store;
-  if (std::find(models.begin(), models.end(), stored) == models.end())
-    throw bad_input(fmt::format("--store {} is not one of --models {}; the stored model must be fitted", stored,
+  calibration::CalibrateCamerasOptions options;
+  options.choose_model = args.models == "auto";
+  options.models = options.choose_model ? calibration::camera_model_names() : parse_models(args.models);
+  if (options.choose_model && args.window_thickness_mm >= 0) options.models.push_back("refractive");
+  if (options.choose_model && !args.store.empty())
+    throw bad_input("--models auto chooses the stored model; --store does not go with it");
+  options.stored = args.store.empty() ? options.models.back() : args.store;
+  if (std::find(options.models.begin(), options.models.end(), options.stored) == options.models.end())
+    throw bad_input(fmt::format("--store {} is not one of --models {}; the stored model must be fitted", options.stored,
                                 args.models));
   if (args.max_iterations < 1)
     throw bad_input(fmt::format("--max-iterations {} is invalid: it must be >= 1", args.max_iterations));
   if (!args.points.empty() && !args.points_out.empty())
     throw bad_input("--points-out writes the points detected in target images; it does not go with --points");
-  const std::optional<calibration::FlatWindow> window = window_of(args, models);
+  options.fit.max_iterations = args.max_iterations;
+  options.fit.window = window_of(args, options.models);
+  options.fit.fit_window_pose = !args.fix_window;
+  options.fit.fit_medium_index = args.fit_medium_index;
+  options.stage_correction = args.stage_correction;
+  options.cross_validate = args.cross_validate;
+  options.notice = [](const std::string& text) { fmt::print(stderr, "{}\n", text); };
   const Inputs in = read_inputs(args);
+  options.camera_names = in.camera_names;
 
-  // With --stage-correction, every model is fitted to the corrected points (docs/calibration.md,
-  // "Traverse-error correction"); the last model of the list comes from the correction itself.
-  std::optional<calibration::TraverseCorrectionResult> traverse;
-  if (args.stage_correction) {
-    calibration::TraverseCorrectionOptions options;
-    options.final_model = models.back();
-    options.camera_names = in.camera_names;
-    options.fit.max_iterations = args.max_iterations;
-    options.fit.window = window;
-    options.fit.fit_window_pose = !args.fix_window;
-    options.fit.fit_medium_index = args.fit_medium_index;
-    traverse = calibration::correct_traverse(in.table.cameras, in.sizes, options);
-  }
-
-  const auto fit_options = [&](std::size_t camera) {
-    calibration::FitOptions options;
-    options.camera = fmt::format("camera {}", camera);
-    options.max_iterations = args.max_iterations;
-    options.window = window;
-    options.fit_window_pose = !args.fix_window;
-    options.fit_medium_index = args.fit_medium_index;
-    return options;
-  };
-  const auto points_of = [&](std::size_t camera) -> const std::vector<calibration::PointCorrespondence>& {
-    return traverse ? traverse->corrected_points[camera] : in.table.cameras[camera];
-  };
-  std::vector<CrossValidation> validation;
-  if (args.cross_validate || automatic) {
-    for (std::size_t i = 0; i < in.table.cameras.size(); ++i)
-      for (const std::string& model_name : models)
-        validation.push_back(cross_validate(model_name, points_of(i), in.sizes[i], fit_options(i), static_cast<int>(i)));
-    if (automatic) {
-      const AutoChoice choice = choose_model(validation, models);
-      stored = choice.model;
-      fmt::print(stderr, "--models auto: {}\n", choice.reason);
-    }
-  }
-
-  // Every camera and model is fitted and reported on its own: a model the points cannot
-  // determine, or a fit that fails, is reported beside the others instead of ending the run.
-  std::vector<ModelResult> results;
-  std::vector<calibration::CameraCalibration> calibrations;
-  std::optional<ErrorKind> stored_failure;
-  for (std::size_t i = 0; i < in.table.cameras.size(); ++i) {
-    const calibration::FitOptions options = fit_options(i);
-    const std::vector<calibration::PointCorrespondence>& points = points_of(i);
-    for (const std::string& model_name : models) {
-      calibration::FitReport report;
-      report.model = model_name;
-      report.camera = options.camera;
-      std::unique_ptr<calibration::CameraModel> model;
-      try {
-        if (traverse && model_name == models.back()) {
-          model = std::move(traverse->models[i]);
-          report = traverse->reports[i];
-        } else {
-          model = calibration::fit_camera_model(model_name, points, in.sizes[i], options, report);
-        }
-      } catch (const Error& e) {
-        fmt::print(stderr, "{} {}: {}: {}\n", model_name == stored ? "error" : "warning", model_name,
-                   e.kind() == ErrorKind::bad_input ? "refused" : "failed", e.what());
-        ModelResult failed{static_cast<int>(i), report, {}};
-        failed.error = e.what();
-        results.push_back(std::move(failed));
-        if (model_name == stored && !stored_failure) stored_failure = e.kind();
-        continue;
-      }
-      std::vector<PlaneResidual> planes = plane_residuals(*model, points);
-      // Corrected points sit at nominal z + offset; report the planes by their nominal z.
-      if (traverse && planes.size() == traverse->plane_z_mm.size())
-        for (std::size_t k = 0; k < planes.size(); ++k) planes[k].z_mm = traverse->plane_z_mm[k];
-      results.push_back({static_cast<int>(i), report, std::move(planes)});
-      if (model_name == stored) calibrations.push_back({static_cast<int>(i), in.sizes[i], std::move(model), report});
-    }
-  }
+  const calibration::CalibrateCamerasReport result = calibration::calibrate_cameras(in.table.cameras, in.sizes, options);
   // Nothing is written unless the stored model fitted every camera.
-  if (!stored_failure) calibration::save_calibration(args.out, calibrations);
-  // A stored model that misses its own points by this much will misplace particles.
-  constexpr double kWarnRmsPx = 0.5;
-  for (const auto& c : calibrations)
-    if (c.report.forward_rms_px > kWarnRmsPx)
-      fmt::print(stderr,
-                 "warning: camera {}: the stored {} model leaves {:.3g} px RMS (max {:.3g} px) on its own points, above "
-                 "{} px; reconstruction with it will lose or misplace particles: check the points, or fit a model "
-                 "that follows the optics (pinhole_distortion, refractive, rational2)\n",
-                 c.id, c.report.model, c.report.forward_rms_px, c.report.forward_max_px, kWarnRmsPx);
-  const std::string written = stored_failure ? std::string() : args.out;
-
-  std::optional<StageOffsets> offsets;
-  if (traverse)
-    offsets = StageOffsets{traverse->plane_z_mm, traverse->offsets_mm, traverse->per_camera_offsets_mm,
-                           in.camera_names, traverse->cycles, traverse->converged};
+  if (!result.stored_failure) calibration::save_calibration(args.out, result.calibrations);
+  for (const std::string& warning : result.poor_fit_warnings()) fmt::print(stderr, "warning: {}\n", warning);
+  const std::string written = result.stored_failure ? std::string() : args.out;
   if (args.json) {
-    nlohmann::json j{{"results", report_json(results)}, {"stored", stored}};
+    nlohmann::json j{{"results", report_json(result.results)}, {"stored", result.stored}};
     j["out"] = written.empty() ? nlohmann::json(nullptr) : nlohmann::json(written);
-    j["stage_correction"] = offsets ? stage_offsets_json(*offsets) : nlohmann::json(nullptr);
-    if (!validation.empty()) j["cross_validation"] = cross_validation_json(validation);
+    j["stage_correction"] = result.offsets ? stage_offsets_json(*result.offsets) : nlohmann::json(nullptr);
+    if (!result.validation.empty()) j["cross_validation"] = cross_validation_json(result.validation);
     fmt::print("{}\n", j.dump(2));
   } else {
-    if (offsets) print_stage_offsets(*offsets);
-    print_report(results, stored, written);
-    if (!validation.empty()) print_cross_validation(validation);
+    if (result.offsets) print_stage_offsets(*result.offsets);
+    print_report(result.results, result.stored, written);
+    if (!result.validation.empty()) print_cross_validation(result.validation);
   }
-  if (stored_failure) {
-    std::vector<int> cameras;
-    for (const ModelResult& r : results)
-      if (!r.error.empty() && r.report.model == stored) cameras.push_back(r.camera);
-    const std::string message =
-        fmt::format("no calibration written: the stored model {} failed for camera {} (reasons above); store another "
-                    "model with --store, or fix the points",
-                    stored, fmt::join(cameras, ", "));
-    if (*stored_failure == ErrorKind::bad_input) throw bad_input(message);
-    throw runtime_error(message);
-  }
+  if (result.stored_failure == ErrorKind::bad_input) throw bad_input(result.failure_message());
+  if (result.stored_failure) throw runtime_error(result.failure_message());
 }
 
 }  // namespace
