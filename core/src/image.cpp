@@ -1,11 +1,29 @@
 #include "tomorig/core/image.h"
 
+#include <cstdlib>
 #include <cstring>
+#include <new>
 #include <string>
 
 #include "tomorig/core/error.h"
 
 namespace tomorig {
+namespace {
+
+// Frames of a megapixel camera start on a memory page: the session writer then hands them to the
+// disk with O_DIRECT as they are (storage/src/direct_write_driver.h), without a copy.
+constexpr std::size_t kPage = 4096;
+constexpr std::size_t kPageAlignFrom = 256 * 1024;
+
+std::shared_ptr<std::byte[]> zeroed_buffer(std::size_t bytes) {
+  if (bytes < kPageAlignFrom) return std::make_shared<std::byte[]>(bytes);  // value-initialised: zeros
+  void* memory = std::aligned_alloc(kPage, (bytes + kPage - 1) / kPage * kPage);
+  if (memory == nullptr) throw std::bad_alloc();
+  std::memset(memory, 0, bytes);
+  return std::shared_ptr<std::byte[]>(static_cast<std::byte*>(memory), [](std::byte* p) { std::free(p); });
+}
+
+}  // namespace
 
 Image Image::allocate(int width, int height, SampleType type) {
   if (width <= 0 || height <= 0)
@@ -16,7 +34,7 @@ Image Image::allocate(int width, int height, SampleType type) {
   image.height_ = height;
   image.type_ = type;
   image.stride_ = image.row_bytes();
-  auto buffer = std::make_shared<std::byte[]>(image.size_bytes());  // value-initialised: zeros
+  auto buffer = zeroed_buffer(image.size_bytes());
   image.data_ = buffer.get();
   image.lease_ = std::move(buffer);
   return image;

@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "compression.h"
+#include "direct_write_driver.h"
 #include "h5_attributes.h"
 #include "h5_datasets.h"
 #include "h5_error.h"
@@ -180,6 +181,8 @@ SessionWriter::Impl::Impl(const fs::path& path, const SessionInfo& info, const S
   // file open (and unflushed) until the last object closes; it catches handle leaks in finish().
   h5::PropertyList fapl(h5::check(H5Pcreate(H5P_FILE_ACCESS), "cannot create", "a file access list"));
   h5::check(H5Pset_fclose_degree(fapl.get(), H5F_CLOSE_SEMI), "cannot configure", "a file access list");
+  // Frame chunks bypass the page cache (direct_write_driver.h says why); the file is ordinary HDF5.
+  set_direct_write_driver(fapl.get());
   // SWMR needs the newest file format (HDF5 >= 1.10 reads it; so do h5py and MATLAB R2021b+).
   if (options.live)
     h5::check(H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_LATEST, H5F_LIBVER_LATEST), "cannot configure",

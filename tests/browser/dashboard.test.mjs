@@ -13,15 +13,9 @@ import { existsSync, mkdtempSync, rmSync, statSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 
-const binary = process.env.TOMORIG_BINARY || new URL('../../build/apps/tomorig', import.meta.url).pathname;
-const chromiumPath = process.env.CHROMIUM || '/usr/bin/chromium';
+import { binary, launchChromium, requireTools, stopChild } from './harness.mjs';
 
-let chromium;
-try {
-  ({ chromium } = await import('playwright-core'));
-} catch {
-  throw new Error('playwright-core is not installed: run `npm ci` in tests/browser (bash scripts/setup.sh test does)');
-}
+
 
 // Starts the run and resolves with the dashboard's address from its stderr.
 function startRun(dir) {
@@ -48,23 +42,13 @@ async function stateSet(url) {
 }
 
 test('the dashboard follows a simulated run in Chromium', { timeout: 90_000 }, async (t) => {
-  assert.ok(existsSync(binary), `tomorig not built at ${binary}`);
-  assert.ok(existsSync(chromiumPath), `Chromium not found at ${chromiumPath} (apt-get install chromium)`);
+  requireTools();
   const dir = mkdtempSync(join(tmpdir(), 'tomorig-browser-'));
   const run = startRun(dir);
-  const browser = await chromium.launch({
-    executablePath: chromiumPath,
-    headless: true,
-    args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
-      '--disable-component-update', '--disable-sync', '--disable-dev-shm-usage'],
-  });
+  const browser = await launchChromium();
   t.after(async () => {
     await browser.close();
-    if (run.child.exitCode === null) {
-      const ended = new Promise((resolve) => run.child.on('exit', resolve));
-      run.child.kill('SIGINT');
-      await ended;
-    }
+    await stopChild(run.child);
     rmSync(dir, { recursive: true, force: true });
   });
 

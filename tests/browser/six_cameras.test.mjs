@@ -8,13 +8,12 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync, spawn } from 'node:child_process';
-import { existsSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 
-const binary = process.env.TOMORIG_BINARY || new URL('../../build/apps/tomorig', import.meta.url).pathname;
-const chromiumPath = process.env.CHROMIUM || '/usr/bin/chromium';
-const { chromium } = await import('playwright-core');
+import { binary, launchChromium, requireTools, stopChild } from './harness.mjs';
+
 
 // The default rig with cam4 and cam5 added between the existing views.
 function sixCameraRig(dir) {
@@ -43,8 +42,7 @@ height = 512
 }
 
 test('six cameras at 10 Hz: the page keeps up and stays responsive', { timeout: 120_000 }, async (t) => {
-  assert.ok(existsSync(binary), `tomorig not built at ${binary}`);
-  assert.ok(existsSync(chromiumPath), `Chromium not found at ${chromiumPath} (apt-get install chromium)`);
+  requireTools();
   const dir = mkdtempSync(join(tmpdir(), 'tomorig-six-'));
   const rig = sixCameraRig(dir);
   const child = spawn(binary, ['run', '--config', rig, '--sets', '100000', '--out', join(dir, 's.h5'), '--status',
@@ -59,19 +57,10 @@ test('six cameras at 10 Hz: the page keeps up and stays responsive', { timeout: 
     });
     child.on('exit', (code) => reject(new Error(`tomorig run ended (${code}) before serving:\n${err}`)));
   });
-  const browser = await chromium.launch({
-    executablePath: chromiumPath,
-    headless: true,
-    args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
-      '--disable-component-update', '--disable-sync', '--disable-dev-shm-usage'],
-  });
+  const browser = await launchChromium();
   t.after(async () => {
     await browser.close();
-    if (child.exitCode === null) {
-      const ended = new Promise((resolve) => child.on('exit', resolve));
-      child.kill('SIGINT');
-      await ended;
-    }
+    await stopChild(child);
     rmSync(dir, { recursive: true, force: true });
   });
 

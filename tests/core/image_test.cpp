@@ -21,6 +21,17 @@ TEST(Image, AllocateIsZeroedAndContiguous) {
     for (int x = 0; x < 7; ++x) EXPECT_EQ(img.at<std::uint16_t>(x, y), 0);
 }
 
+// The session writer hands frames this large to the disk with O_DIRECT without a copy only
+// when they start on a memory page.
+TEST(Image, MegapixelFramesStartOnAPageAndAreZeroed) {
+  for (const int side : {512, 1000, 2048}) {
+    Image img = Image::allocate(side, side, SampleType::u16);
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(img.data()) % 4096, 0u) << side;
+    EXPECT_EQ(img.at<std::uint16_t>(side - 1, side - 1), 0);
+    EXPECT_EQ(img.at<std::uint16_t>(side / 2, side / 3), 0);
+  }
+}
+
 TEST(Image, RejectsNonPositiveSizeWithBadInput) {
   try {
     Image::allocate(0, 5, SampleType::u8);
