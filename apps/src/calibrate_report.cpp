@@ -54,30 +54,47 @@ void print_report(const std::vector<ModelResult>& results, const std::string& st
 }
 
 CrossValidation cross_validate(const std::string& model, std::span<const calibration::PointCorrespondence> points,
-                               calibration::ImageSize size, const calibration::FitOptions& options, int camera) {
+                               calibration::ImageSize size, const calibration::FitOptions& options, int camera,
+                               LeaveOut left_out) {
   CrossValidation cv;
   cv.camera = camera;
   cv.model = model;
-  std::map<double, std::vector<calibration::PointCorrespondence>> by_z;
-  for (const auto& p : points) by_z[p.world.z].push_back(p);
+  cv.left_out = left_out;
+  // Folds: the indices of the points left out together (one plane, or one point).
+  std::vector<std::vector<std::size_t>> folds;
+  if (left_out == LeaveOut::plane) {
+    std::map<double, std::vector<std::size_t>> by_z;
+    for (std::size_t k = 0; k < points.size(); ++k) by_z[points[k].world.z].push_back(k);
+    for (auto& [z, indices] : by_z) folds.push_back(std::move(indices));
+  } else {
+    for (std::size_t k = 0; k < points.size(); ++k) folds.push_back({k});
+  }
   double squares = 0;
-  for (const auto& [z, left_out] : by_z) {
+  std::vector<bool> out(points.size(), false);
+  for (const std::vector<std::size_t>& fold : folds) {
+    for (std::size_t k : fold) out[k] = true;
     std::vector<calibration::PointCorrespondence> kept;
-    for (const auto& p : points)
-      if (p.world.z != z) kept.push_back(p);
+    kept.reserve(points.size());
+    for (std::size_t k = 0; k < points.size(); ++k)
+      if (!out[k]) kept.push_back(points[k]);
+    for (std::size_t k : fold) out[k] = false;
     try {
       calibration::FitReport report;
       const auto fitted = calibration::fit_camera_model(model, kept, size, options, report);
-      for (const auto& p : left_out) {
-        const Vec2d u = fitted->project(p.world);
-        const double d = std::hypot(u.x - p.pixel.x, u.y - p.pixel.y);
+      for (std::size_t k : fold) {
+        const Vec2d u = fitted->project(points[k].world);
+        const double d = std::hypot(u.x - points[k].pixel.x, u.y - points[k].pixel.y);
         squares += d * d;
         cv.max_px = std::max(cv.max_px, d);
         ++cv.points;
       }
       ++cv.folds;
     } catch (const Error& e) {
-      cv.error = fmt::format("without plane z = {} mm: {}", z, e.what());
+      const auto& first = points[fold.front()];
+      cv.error = left_out == LeaveOut::plane
+                     ? fmt::format("without plane z = {} mm: {}", first.world.z, e.what())
+                     : fmt::format("without the point ({}, {}, {}) mm: {}", first.world.x, first.world.y, first.world.z,
+                                   e.what());
       return cv;
     }
   }
@@ -104,17 +121,19 @@ AutoChoice choose_model(const std::vector<CrossValidation>& results, const std::
                     "reasons above); list the models with --models");
   std::sort(ranked.begin(), ranked.end());
   AutoChoice choice{ranked.front().second, {}};
-  choice.reason = fmt::format("stored {}: the lowest leave-one-plane-out RMS, {:.4g} px averaged over the cameras", choice.model,
-                              ranked.front().first);
+  const bool by_point = !results.empty() && results.front().left_out == LeaveOut::point;
+  choice.reason = fmt::format("stored {}: the lowest leave-one-{}-out RMS, {:.4g} px averaged over the cameras", choice.model,
+                              by_point ? "point" : "plane", ranked.front().first);
   if (ranked.size() > 1)
     choice.reason += fmt::format(" (next: {} {:.4g} px)", ranked[1].second, ranked[1].first);
   return choice;
 }
 
 void print_cross_validation(const std::vector<CrossValidation>& results) {
-  fmt::print("\ncross-validation (each plane left out in turn, the model fitted to the others):\n{:>6}  {:<18} {:>6} "
+  const bool by_point = !results.empty() && results.front().left_out == LeaveOut::point;
+  fmt::print("\ncross-validation (each {} left out in turn, the model fitted to the others):\n{:>6}  {:<18} {:>6} "
              "{:>7} {:>10} {:>10}\n",
-             "camera", "model", "folds", "points", "RMS px", "max px");
+             by_point ? "point" : "plane", "camera", "model", "folds", "points", "RMS px", "max px");
   for (const CrossValidation& cv : results) {
     if (!cv.error.empty())
       fmt::print("{:>6}  {:<18} refused or failed: {}\n", cv.camera, cv.model, cv.error);
@@ -127,7 +146,11 @@ void print_cross_validation(const std::vector<CrossValidation>& results) {
 nlohmann::json cross_validation_json(const std::vector<CrossValidation>& results) {
   nlohmann::json list = nlohmann::json::array();
   for (const CrossValidation& cv : results) {
-    nlohmann::json j{{"camera", cv.camera}, {"model", cv.model}, {"folds", cv.folds}, {"points", cv.points}};
+    nlohmann::json j{{"camera", cv.camera},
+                     {"model", cv.model},
+                     {"left_out", cv.left_out == LeaveOut::point ? "point" : "plane"},
+                     {"folds", cv.folds},
+                     {"points", cv.points}};
     if (!cv.error.empty()) j["error"] = cv.error;
     else j["rms_px"] = cv.rms_px, j["max_px"] = cv.max_px;
     list.push_back(j);

@@ -46,19 +46,25 @@ struct StageOffsets {
 void print_stage_offsets(const StageOffsets& s);
 nlohmann::json stage_offsets_json(const StageOffsets& s);
 
-// Leave-one-plane-out cross-validation of one model on one camera: each plane in turn is left
-// out, the model fitted to the others and its error measured on the plane left out.
+// Cross-validation of one model on one camera: each plane (or each point) in turn is left out,
+// the model fitted to the others and its error measured on what was left out. Leaving planes
+// out tests the model between and beyond the planes (depth); leaving points out tests it within
+// the calibrated planes, where a plane left out would leave too few planes (2 or 3 planes).
+enum class LeaveOut { plane, point };
+
 struct CrossValidation {
   int camera = 0;
   std::string model;
-  int folds = 0;           // planes left out in turn
+  LeaveOut left_out = LeaveOut::plane;
+  int folds = 0;           // planes (or points) left out in turn
   int points = 0;          // points evaluated (all of them, each once)
   double rms_px = 0;       // forward residual on the left-out planes
   double max_px = 0;
   std::string error;       // why a fold could not be fitted ("" if all could)
 };
 CrossValidation cross_validate(const std::string& model, std::span<const calibration::PointCorrespondence> points,
-                               calibration::ImageSize size, const calibration::FitOptions& options, int camera);
+                               calibration::ImageSize size, const calibration::FitOptions& options, int camera,
+                               LeaveOut left_out = LeaveOut::plane);
 
 // --models auto: the model whose cross-validated RMS, averaged over the cameras, is lowest among
 // those that every camera could fit; the reason names the runner-up. Throws bad_input if none.

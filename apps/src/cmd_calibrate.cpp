@@ -83,7 +83,7 @@ struct CalibrateArgs {
   std::string check;  // --check CALIB: evaluate a calibration on --points instead of fitting
   bool overwrite = false;
   bool json = false;
-  bool cross_validate = false;  // leave one plane out, per camera and model
+  std::string cross_validate;  // "", "planes" (leave one plane out) or "points" (one point), per camera and model
 };
 
 std::vector<std::string> split_list(const std::string& text) {
@@ -411,10 +411,16 @@ void run(const CalibrateArgs& args) {
     return traverse ? traverse->corrected_points[camera] : in.table.cameras[camera];
   };
   std::vector<CrossValidation> validation;
-  if (args.cross_validate || automatic) {
+  if (!args.cross_validate.empty() || automatic) {
+    if (!args.cross_validate.empty() && args.cross_validate != "planes" && args.cross_validate != "points")
+      throw bad_input(fmt::format("--cross-validate={} is invalid: planes (leave one plane out, the default) or points "
+                                  "(leave one point out)",
+                                  args.cross_validate));
+    const LeaveOut left_out = args.cross_validate == "points" ? LeaveOut::point : LeaveOut::plane;
     for (std::size_t i = 0; i < in.table.cameras.size(); ++i)
       for (const std::string& model_name : models)
-        validation.push_back(cross_validate(model_name, points_of(i), in.sizes[i], fit_options(i), static_cast<int>(i)));
+        validation.push_back(
+            cross_validate(model_name, points_of(i), in.sizes[i], fit_options(i), static_cast<int>(i), left_out));
     if (automatic) {
       const AutoChoice choice = choose_model(validation, models);
       stored = choice.model;
@@ -545,7 +551,7 @@ void add_calibrate_command(CLI::App& root) {
   cmd->add_option("--models", args->models,
                   "Models to fit, comma-separated: " + fmt::format("{}", fmt::join(calibration::all_camera_model_names(), ",")) +
                       "; each is fitted and reported, the last one is stored; auto: all of them, storing the one with the lowest "
-                      "leave-one-plane-out error")
+                      "cross-validated error (leave one plane out, or one point with --cross-validate=points)")
       ->capture_default_str();
   cmd->add_option("--store", args->store, "Model to store in the calibration file (default: the last of --models)");
   cmd->add_option("--image-size", args->image_size, "Image size W,H in pixels of every camera");
@@ -571,9 +577,10 @@ void add_calibrate_command(CLI::App& root) {
                   "mean and max residuals per camera");
   cmd->add_flag("--overwrite", args->overwrite, "Replace the calibration file if it exists");
   cmd->add_flag("--json", args->json, "Print the report as one JSON object");
-  cmd->add_flag("--cross-validate", args->cross_validate,
-                "Also report each model's leave-one-plane-out error per camera (fit on the other planes, RMS px on the "
-                "plane left out)");
+  cmd->add_flag("--cross-validate{planes}", args->cross_validate,
+                "Also report each model's cross-validated error per camera: --cross-validate (or =planes) leaves one "
+                "plane out in turn, --cross-validate=points one point (fit on the rest, RMS px on what was left out); "
+                "--models auto uses the same");
   cmd->callback([args, cmd] {
     for (const char* name : {"--target", "--spacing", "--dots", "--y-axis", "--corners", "--max-feature-px", "--lattice",
                              "--level-offset"})
