@@ -467,15 +467,8 @@ void run(const CalibrateArgs& args) {
   }
   // Nothing is written unless the stored model fitted every camera.
   if (!stored_failure) calibration::save_calibration(args.out, calibrations);
-  // A stored model that misses its own points by this much will misplace particles.
-  constexpr double kWarnRmsPx = 0.5;
   for (const auto& c : calibrations)
-    if (c.report.forward_rms_px > kWarnRmsPx)
-      fmt::print(stderr,
-                 "warning: camera {}: the stored {} model leaves {:.3g} px RMS (max {:.3g} px) on its own points, above "
-                 "{} px; reconstruction with it will lose or misplace particles: check the points, or fit a model "
-                 "that follows the optics (pinhole_distortion, refractive, rational2)\n",
-                 c.id, c.report.model, c.report.forward_rms_px, c.report.forward_max_px, kWarnRmsPx);
+    if (const std::string warning = calibration::rms_warning(c); !warning.empty()) fmt::print(stderr, "warning: {}\n", warning);
   const std::string written = stored_failure ? std::string() : args.out;
 
   std::optional<StageOffsets> offsets;

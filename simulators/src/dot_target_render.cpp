@@ -74,6 +74,11 @@ double DotPlate::ink(double x, double y, int level) const {
 }
 
 Image render_dot_plate(const calibration::CameraModel& camera, const DotPlate& plate, double z_mm, int width, int height) {
+  return render_dot_plate([&](const Vec2d& pixel, double z) { return camera.back_project(pixel, z); }, plate, z_mm, width,
+                          height);
+}
+
+Image render_dot_plate(const BackProjection& back_project, const DotPlate& plate, double z_mm, int width, int height) {
   plate.validate();
   const auto& o = plate.spec.origin_mm;
   const double z0 = z_mm + o.z, z1 = z0 + plate.spec.level_offset_mm;
@@ -87,10 +92,10 @@ Image render_dot_plate(const calibration::CameraModel& camera, const DotPlate& p
       for (int a = 0; a < n; ++a)
         for (int b = 0; b < n; ++b) {
           const Vec2d px{u - 0.5 + (a + 0.5) / n, v - 0.5 + (b + 0.5) / n};
-          const Vec3d p0 = camera.back_project(px, z0);
+          const Vec3d p0 = back_project(px, z0);
           double ink = plate.ink(p0.x - o.x, p0.y - o.y, 0);
           if (ink == 0 && two_levels) {
-            const Vec3d p1 = camera.back_project(px, z1);
+            const Vec3d p1 = back_project(px, z1);
             ink = plate.ink(p1.x - o.x, p1.y - o.y, 1);
           }
           sum += ink;

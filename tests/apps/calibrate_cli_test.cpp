@@ -471,6 +471,31 @@ TEST_F(CalibrateCli, TheFileDrivesReconstructOnASimulatedSession) {
                                     shell_quoted((dir_ / "v.h5").string()));
   ASSERT_EQ(rec.exit_code, 0) << rec.err;
   EXPECT_EQ(nlohmann::json::parse(rec.out)["volumes"]["a"]["algorithm"], "mlos");
+  EXPECT_EQ(rec.err.find("warning: calibration file"), std::string::npos) << rec.err;
+
+  // A calibration fitted to points a pixel off (RMS above 0.5 px): calibrate warns when it
+  // stores it, and reconstruct and process repeat the warning when they load it.
+  const auto wobble = [](Vec2d p) { return Vec2d{p.x + 1.2 * std::sin(0.37 * p.y), p.y + 1.2 * std::cos(0.29 * p.x)}; };
+  const std::string poor_points = write_points(csv_rows(cameras, {-1.5, -0.5, 0.5, 1.5}, 4.5, 6, wobble), "poor.csv");
+  const std::string poor = (dir_ / "poor.toml").string();
+  const CliResult poor_cal =
+      run_tomorig("calibrate --points " + poor_points + " --models pinhole" + sizes + " -o " + shell_quoted(poor));
+  ASSERT_EQ(poor_cal.exit_code, 0) << poor_cal.err;
+  EXPECT_NE(poor_cal.err.find("warning: camera 0: the stored pinhole model leaves"), std::string::npos) << poor_cal.err;
+  const CliResult poor_rec = run_tomorig("reconstruct --session " + shell_quoted(session) + " --calib " + shell_quoted(poor) +
+                                         " --algorithm mlos --grid 64,64,16,0.0195 -o " +
+                                         shell_quoted((dir_ / "v2.h5").string()));
+  ASSERT_EQ(poor_rec.exit_code, 0) << poor_rec.err;
+  EXPECT_NE(poor_rec.err.find("warning: calibration file '" + poor + "': camera 0: the stored pinhole model leaves"),
+            std::string::npos)
+      << poor_rec.err;
+  EXPECT_NE(poor_rec.err.find("above 0.5 px"), std::string::npos) << poor_rec.err;
+  const CliResult poor_process = run_tomorig("process --session " + shell_quoted(session) + " --calib " + shell_quoted(poor) +
+                                             " --grid 32,32,16,0.0195 --window 16,16,8 --quiet -o " +
+                                             shell_quoted((dir_ / "r.h5").string()));
+  EXPECT_NE(poor_process.err.find("warning: calibration file '" + poor + "': camera 0: the stored pinhole model"),
+            std::string::npos)
+      << poor_process.err;
 }
 
 }  // namespace

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -16,7 +18,9 @@
 #include "../processing/calibration/dot_grid_render.h"
 #include "cli_runner.h"
 #include "tomorig/processing/calibration/calibration_file.h"
+#include "tomorig/processing/calibration/lens_camera.h"
 #include "tomorig/simulators/dot_target.h"
+#include "tomorig/simulators/window_view.h"
 #include "tomorig/storage/image_file.h"
 
 namespace tomorig::testing {
@@ -209,6 +213,88 @@ TEST_F(CalibrateImagesCli, StaggeredTwoLevelPlateFromATargetFile) {
                                     shell_quoted((dir_ / "bad.toml").string()) + " -o " + shell_quoted(out + "3"));
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("level_offset_mm needs lattice = \"staggered\""), std::string::npos) << bad.err;
+}
+
+// Issue 18 end to end on rendered images: a dot plate on 7 planes seen through a lens with
+// barrel distortion, and through 10 mm of glass into water (1.0 / 1.49 / 1.33), each drawn by
+// the simulator (sim::render_dot_plate through the true view) and calibrated by `tomorig
+// calibrate --images` alone. The stored pinhole_distortion / refractive model must be within
+// 0.05 px of the true view at points not used in the fit (between the planes and the dots).
+class CalibrateRenderedOpticsCli : public CalibrateImagesCli {
+ protected:
+  static constexpr int kW = 480, kH = 400;
+  fs::path render(const std::string& name, const sim::BackProjection& view) {
+    sim::DotPlate plate;
+    plate.spec.spacing_mm = 2.0;
+    plate.triangle_site = 2;
+    plate.noise_counts = 8;
+    const fs::path root = dir_ / name;
+    fs::create_directories(root / "cam0");
+    for (int k = 0; k < 7; ++k) {
+      const double z = -6.0 + 2.0 * k;
+      plate.seed = 40 + k;
+      storage::write_png(root / "cam0" / fmt::format("{}mm_cam0.png", z), sim::render_dot_plate(view, plate, z, kW, kH));
+    }
+    return root;
+  }
+  // Largest distance between the stored model and the truth over random points in the box
+  // the planes span.
+  static double held_out_error(const calibration::CameraModel& stored, const std::function<Vec2d(const Vec3d&)>& truth) {
+    std::mt19937_64 rng(21);
+    std::uniform_real_distribution<double> xy(-6.0, 6.0), z(-6.0, 6.0);
+    double worst = 0;
+    for (int k = 0; k < 300; ++k) {
+      const Vec3d world{xy(rng), xy(rng), z(rng)};
+      const Vec2d a = truth(world), b = stored.project(world);
+      worst = std::max(worst, std::hypot(a.x - b.x, a.y - b.y));
+    }
+    return worst;
+  }
+};
+
+TEST_F(CalibrateRenderedOpticsCli, LensDistortionThroughRenderedImages) {
+  const PinholeCamera pinhole = dot_grid_test::oblique_camera(22, 6, 2, 22, 300, kW, kH);
+  calibration::LensDistortion barrel;
+  barrel.k1 = -9;  // ideal radius ~0.047 at the image corners (fx = 6600 px): 2 % barrel, ~6 px there
+  const calibration::LensCamera lens(pinhole.parameters(), barrel);
+  const fs::path images = render("lens", [&](const Vec2d& p, double z) { return lens.back_project(p, z); });
+  const std::string out = (dir_ / "lens.toml").string();
+  const CliResult r = run_tomorig("calibrate --images " + shell_quoted(images.string()) +
+                                  " --spacing 2 --y-axis down --models pinhole,pinhole_distortion --json -o " +
+                                  shell_quoted(out));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto loaded = calibration::load_calibration(out);
+  ASSERT_EQ(loaded.size(), 1u);
+  EXPECT_EQ(loaded[0].model->model_name(), "pinhole_distortion");
+  double corner = 0;
+  for (const Vec3d w : {Vec3d{-6, -6, 0}, Vec3d{6, 6, 0}, Vec3d{-6, 6, 6}, Vec3d{6, -6, -6}})
+    corner = std::max(corner, std::hypot(lens.project(w).x - pinhole.project(w).x, lens.project(w).y - pinhole.project(w).y));
+  EXPECT_GT(corner, 1.0);  // within the held-out box; the distortion the plain pinhole cannot follow
+  EXPECT_LT(held_out_error(*loaded[0].model, [&](const Vec3d& w) { return lens.project(w); }), 0.05);
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_GT(j["results"][0]["forward_rms_px"].get<double>(), 0.2) << j["results"][0].dump();  // pinhole
+}
+
+TEST_F(CalibrateRenderedOpticsCli, RefractiveThroughRenderedImagesBehindGlassIntoWater) {
+  calibration::FlatWindow window;
+  window.normal = {std::sin(0.3 * M_PI / 180), 0, std::cos(0.3 * M_PI / 180)};
+  window.medium_face_mm = -20;
+  window.thickness_mm = 10;
+  window.n_air = 1.0, window.n_window = 1.49, window.n_medium = 1.33;
+  const sim::WindowView view{dot_grid_test::oblique_camera(20, 4, 1, 22, 300, kW, kH), window};
+  const fs::path images = render("window", [&](const Vec2d& p, double z) { return view.back_project(p, z); });
+  const std::string out = (dir_ / "window.toml").string();
+  const CliResult r = run_tomorig("calibrate --images " + shell_quoted(images.string()) +
+                                  " --spacing 2 --y-axis down --models pinhole,refractive --window-thickness 10 "
+                                  "--indices 1.0,1.49,1.33 --window-face -21 --window-normal 0,0,1 --json -o " +
+                                  shell_quoted(out));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto loaded = calibration::load_calibration(out);
+  ASSERT_EQ(loaded.size(), 1u);
+  EXPECT_EQ(loaded[0].model->model_name(), "refractive");
+  EXPECT_LT(held_out_error(*loaded[0].model, [&](const Vec3d& w) { return view.project(w); }), 0.05);
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_GT(j["results"][0]["forward_rms_px"].get<double>(), 0.1) << j["results"][0].dump();  // pinhole
 }
 
 }  // namespace

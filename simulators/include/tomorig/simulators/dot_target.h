@@ -9,6 +9,7 @@
 //   plate.spec.level_offset_mm = 1;  plate.triangle_site = 2;
 //   Image img = sim::render_dot_plate(camera, plate, z, 400, 320);
 #include <cstdint>
+#include <functional>
 
 #include "tomorig/core/image.h"
 #include "tomorig/processing/calibration/camera_model.h"
@@ -37,5 +38,10 @@ struct DotPlate {
 // A 16-bit image of the plate with its origin site at world spec.origin_mm + (0, 0, z_mm)
 // (the second level at + level_offset_mm along z) seen by `camera`.
 Image render_dot_plate(const calibration::CameraModel& camera, const DotPlate& plate, double z_mm, int width, int height);
+
+// The same through any view given by its back-projection (the world point on plane z seen at a
+// pixel), e.g. a sim::WindowView, the simulator's own camera behind a window.
+using BackProjection = std::function<Vec3d(const Vec2d& pixel, double world_z)>;
+Image render_dot_plate(const BackProjection& back_project, const DotPlate& plate, double z_mm, int width, int height);
 
 }  // namespace tomorig::sim
