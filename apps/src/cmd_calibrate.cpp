@@ -55,6 +55,7 @@ struct CalibrateArgs {
   std::string z_list;
   bool stage_correction = false;
   std::string points_out;
+  std::string overlay;  // --overlay DIR: a PNG per target image showing what was detected
   // Target spec (with --images / --image-list).
   std::string target = "dots";
   double spacing_mm = 0;
@@ -320,8 +321,9 @@ Inputs read_inputs(const CalibrateArgs& args) {
   const TargetImageSet set = !args.session.empty()  ? read_session_targets(args.session, parse_z_list(args.z_list))
                              : !args.images.empty() ? find_target_images(args.images)
                                                     : read_image_list(args.image_list);
-  DetectedTargets detected = detect_targets(set, spec, args.min_points_per_plane);
+  DetectedTargets detected = detect_targets(set, spec, args.min_points_per_plane, {args.overlay, args.overwrite});
   for (const std::string& warning : detected.warnings) fmt::print(stderr, "warning: {}\n", warning);
+  for (const std::string& origin : detected.origins) fmt::print(stderr, "{}\n", origin);
   if (std::holds_alternative<calibration::DotGridSpec>(spec) && y_axis == "auto")
     fmt::print(stderr, "world +y points {} the images (--y-axis auto: a right-handed x, y, z)\n", orient_y_axis(detected));
   for (std::size_t c = 0; c < set.camera_names.size(); ++c)
@@ -379,6 +381,8 @@ void run(const CalibrateArgs& args) {
                                 args.models));
   if (args.max_iterations < 1)
     throw bad_input(fmt::format("--max-iterations {} is invalid: it must be >= 1", args.max_iterations));
+  if (!args.points.empty() && !args.overlay.empty())
+    throw bad_input("--overlay draws what was detected in target images; it does not go with --points");
   if (!args.points.empty() && !args.points_out.empty())
     throw bad_input("--points-out writes the points detected in target images; it does not go with --points");
   const std::optional<calibration::FlatWindow> window = window_of(args, models);
@@ -541,6 +545,9 @@ void add_calibrate_command(CLI::App& root) {
                   "Fewest target points an image must yield; fewer is an error naming camera and plane")
       ->capture_default_str();
   cmd->add_option("--points-out", args->points_out, "Also write the detected points as a correspondence CSV");
+  cmd->add_option("--overlay", args->overlay,
+                  "Target images: write DIR/cam<i>_<z>mm.png per image, the detected points circled, the origin ringed "
+                  "and the +x, +y axes drawn (existing files need --overwrite)");
   cmd->add_option("--models", args->models,
                   "Models to fit, comma-separated: " + fmt::format("{}", fmt::join(calibration::all_camera_model_names(), ",")) +
                       "; each is fitted and reported, the last one is stored; auto: all of them, storing the one with the lowest "

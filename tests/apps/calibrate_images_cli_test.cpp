@@ -182,9 +182,27 @@ TEST_F(CalibrateImagesCli, StaggeredTwoLevelPlateFromATargetFile) {
   std::ofstream(target) << "kind = \"dots\"\npitch_mm = 2.0\nlattice = \"staggered\"\nlevel_offset_mm = -0.5\n"
                            "y_axis = \"down\"\n";
   const std::string out = (dir_ / "plate_calib.toml").string();
+  const fs::path overlay = dir_ / "overlay";
   const CliResult r = run_tomorig("calibrate --images " + shell_quoted(images.string()) + " --target-file " +
-                                  shell_quoted(target.string()) + " --models pinhole --json -o " + shell_quoted(out));
+                                  shell_quoted(target.string()) + " --models pinhole --json --overlay " +
+                                  shell_quoted(overlay.string()) + " -o " + shell_quoted(out));
   ASSERT_EQ(r.exit_code, 0) << r.err;
+  // Where the origin went, and how the axes were set, for every image; and the overlay shows it.
+  EXPECT_NE(r.err.find("camera 1, plane z = 2 mm"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("origin (filled square) at ("), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("set by the triangle"), std::string::npos) << r.err;
+  for (std::size_t c = 0; c < cams.size(); ++c) {
+    const Image drawn = storage::read_image(overlay / fmt::format("cam{}_2mm.png", c));
+    ASSERT_EQ(drawn.width(), kWidth);
+    const Vec2d o = cams[c].project({0, 0, 2});
+    // The origin's ring (9 px) is drawn in white over an image dimmed to <= 160.
+    EXPECT_GT(drawn.value(static_cast<int>(std::lround(o.x + 9)), static_cast<int>(std::lround(o.y))), 200) << c;
+  }
+  const CliResult again = run_tomorig("calibrate --images " + shell_quoted(images.string()) + " --target-file " +
+                                      shell_quoted(target.string()) + " --overlay " + shell_quoted(overlay.string()) +
+                                      " -o " + shell_quoted((dir_ / "again.toml").string()));
+  EXPECT_EQ(again.exit_code, 2);
+  EXPECT_NE(again.err.find("exists; give --overwrite"), std::string::npos) << again.err;
   for (const nlohmann::json& result : nlohmann::json::parse(r.out)["results"]) {
     EXPECT_EQ(result["planes"], 6) << result.dump();  // 3 plane positions x 2 levels
     EXPECT_GT(result["points"].get<int>(), 3 * 150) << result.dump();
