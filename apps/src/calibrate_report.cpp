@@ -40,9 +40,10 @@ void print_report(const std::vector<ModelResult>& results, const std::string& st
 }
 
 void print_cross_validation(const std::vector<CrossValidation>& results) {
-  fmt::print("\ncross-validation (each plane left out in turn, the model fitted to the others):\n{:>6}  {:<18} {:>6} "
+  const bool by_point = !results.empty() && results.front().left_out == LeaveOut::point;
+  fmt::print("\ncross-validation (each {} left out in turn, the model fitted to the others):\n{:>6}  {:<18} {:>6} "
              "{:>7} {:>10} {:>10}\n",
-             "camera", "model", "folds", "points", "RMS px", "max px");
+             by_point ? "point" : "plane", "camera", "model", "folds", "points", "RMS px", "max px");
   for (const CrossValidation& cv : results) {
     if (!cv.error.empty())
       fmt::print("{:>6}  {:<18} refused or failed: {}\n", cv.camera, cv.model, cv.error);
@@ -55,7 +56,11 @@ void print_cross_validation(const std::vector<CrossValidation>& results) {
 nlohmann::json cross_validation_json(const std::vector<CrossValidation>& results) {
   nlohmann::json list = nlohmann::json::array();
   for (const CrossValidation& cv : results) {
-    nlohmann::json j{{"camera", cv.camera}, {"model", cv.model}, {"folds", cv.folds}, {"points", cv.points}};
+    nlohmann::json j{{"camera", cv.camera},
+                     {"model", cv.model},
+                     {"left_out", cv.left_out == LeaveOut::point ? "point" : "plane"},
+                     {"folds", cv.folds},
+                     {"points", cv.points}};
     if (!cv.error.empty()) j["error"] = cv.error;
     else j["rms_px"] = cv.rms_px, j["max_px"] = cv.max_px;
     list.push_back(j);

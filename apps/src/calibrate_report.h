@@ -12,6 +12,7 @@
 namespace tomorig::app {
 
 using calibration::CrossValidation;
+using calibration::LeaveOut;
 using calibration::ModelResult;
 using calibration::PlaneResidual;
 using calibration::StageOffsets;

@@ -28,6 +28,7 @@
 #include "tomorig/processing/calibration/calibration_file.h"
 #include "tomorig/processing/calibration/calibrate_cameras.h"
 #include "tomorig/processing/calibration/fit_camera_model.h"
+#include "tomorig/processing/calibration/target_file.h"
 #include "tomorig/storage/output_path.h"
 
 namespace tomorig::app {
@@ -54,6 +55,7 @@ struct CalibrateArgs {
   std::string z_list;
   bool stage_correction = false;
   std::string points_out;
+  std::string overlay;  // --overlay DIR: a PNG per target image showing what was detected
   // Target spec (with --images / --image-list).
   std::string target = "dots";
   double spacing_mm = 0;
@@ -61,6 +63,10 @@ struct CalibrateArgs {
   std::string y_axis = "auto";
   std::string corners;
   double max_feature_px = 0;
+  std::string lattice = "square";
+  double level_offset_mm = 0;
+  std::string target_file;                  // --target-file T.toml: the target spec from a file
+  std::vector<std::string> target_options;  // the target options given on the command line
   int min_points_per_plane = 8;
   std::string models = "pinhole";
   std::string store;  // empty: the last of --models
@@ -78,7 +84,7 @@ struct CalibrateArgs {
   std::string check;  // --check CALIB: evaluate a calibration on --points instead of fitting
   bool overwrite = false;
   bool json = false;
-  bool cross_validate = false;  // leave one plane out, per camera and model
+  std::string cross_validate;  // "", "planes" (leave one plane out) or "points" (one point), per camera and model
 };
 
 std::vector<std::string> split_list(const std::string& text) {
@@ -153,8 +159,19 @@ std::vector<calibration::ImageSize> image_sizes(const CalibrateArgs& args, std::
   return sizes;
 }
 
-// The target spec from the command line.
-calibration::TargetSpec target_spec(const CalibrateArgs& args) {
+// The target spec from --target-file or the command line; `y_axis` is set to the image
+// direction of world +y asked for (auto, down or up).
+calibration::TargetSpec target_spec(const CalibrateArgs& args, std::string& y_axis) {
+  y_axis = args.y_axis;
+  if (!args.target_file.empty()) {
+    if (!args.target_options.empty())
+      throw bad_input(fmt::format("--target-file {} describes the target; {} do(es) not go with it: put the value in "
+                                  "the file",
+                                  args.target_file, fmt::join(args.target_options, ", ")));
+    calibration::TargetFile file = calibration::read_target_file(args.target_file);
+    y_axis = file.y_axis;
+    return file.spec;
+  }
   if (!(args.spacing_mm > 0))
     throw bad_input(fmt::format("--spacing {} is invalid: give the target's dot spacing or chessboard square size in mm "
                                 "(> 0), e.g. --spacing 3",
@@ -171,6 +188,16 @@ calibration::TargetSpec target_spec(const CalibrateArgs& args) {
     if (!(args.max_feature_px >= 0))
       throw bad_input(fmt::format("--max-feature-px {} is invalid: it must be >= 0 (0 = automatic)", args.max_feature_px));
     spec.max_feature_px = args.max_feature_px;
+    if (args.lattice != "square" && args.lattice != "staggered")
+      throw bad_input(fmt::format("--lattice '{}' is invalid: square or staggered (a second sub-lattice at the cell "
+                                  "centres, possibly on a second depth level)",
+                                  args.lattice));
+    spec.lattice = args.lattice == "staggered" ? calibration::DotLattice::staggered : calibration::DotLattice::square;
+    if (!std::isfinite(args.level_offset_mm) || (args.level_offset_mm != 0 && spec.lattice != calibration::DotLattice::staggered))
+      throw bad_input(fmt::format("--level-offset {} needs --lattice staggered: the second level's dots sit between the "
+                                  "first's",
+                                  args.level_offset_mm));
+    spec.level_offset_mm = args.level_offset_mm;
     return spec;
   }
   if (args.target == "chessboard") {
@@ -277,6 +304,8 @@ Inputs read_inputs(const CalibrateArgs& args) {
     throw bad_input("--z-list gives the plane z of each set of a --session; it does not go with other sources");
   Inputs in;
   if (!args.points.empty()) {
+    if (!args.target_file.empty())
+      throw bad_input("--target-file describes the target in target images; it does not go with --points");
     in.table = read_correspondence_csv(args.points);
     in.sizes = image_sizes(args, in.table.cameras.size());
     check_inside_images(args.points, in.table, in.sizes);
@@ -287,13 +316,15 @@ Inputs read_inputs(const CalibrateArgs& args) {
     throw bad_input("--image-size and --camera-size go with --points only; with target images the size is the images'");
   if (args.min_points_per_plane < 1)
     throw bad_input(fmt::format("--min-points-per-plane {} is invalid: it must be >= 1", args.min_points_per_plane));
-  const calibration::TargetSpec spec = target_spec(args);
+  std::string y_axis;
+  const calibration::TargetSpec spec = target_spec(args, y_axis);
   const TargetImageSet set = !args.session.empty()  ? read_session_targets(args.session, parse_z_list(args.z_list))
                              : !args.images.empty() ? find_target_images(args.images)
                                                     : read_image_list(args.image_list);
-  DetectedTargets detected = detect_targets(set, spec, args.min_points_per_plane);
+  DetectedTargets detected = detect_targets(set, spec, args.min_points_per_plane, {args.overlay, args.overwrite});
   for (const std::string& warning : detected.warnings) fmt::print(stderr, "warning: {}\n", warning);
-  if (args.target == "dots" && args.y_axis == "auto")
+  for (const std::string& origin : detected.origins) fmt::print(stderr, "{}\n", origin);
+  if (std::holds_alternative<calibration::DotGridSpec>(spec) && y_axis == "auto")
     fmt::print(stderr, "world +y points {} the images (--y-axis auto: a right-handed x, y, z)\n", orient_y_axis(detected));
   for (std::size_t c = 0; c < set.camera_names.size(); ++c)
     fmt::print(stderr, "camera {} ({}): {} target points on {} images of {} x {} px\n", c, set.camera_names[c],
@@ -352,6 +383,8 @@ void run(const CalibrateArgs& args) {
                                 args.models));
   if (args.max_iterations < 1)
     throw bad_input(fmt::format("--max-iterations {} is invalid: it must be >= 1", args.max_iterations));
+  if (!args.points.empty() && !args.overlay.empty())
+    throw bad_input("--overlay draws what was detected in target images; it does not go with --points");
   if (!args.points.empty() && !args.points_out.empty())
     throw bad_input("--points-out writes the points detected in target images; it does not go with --points");
   options.fit.max_iterations = args.max_iterations;
@@ -359,7 +392,12 @@ void run(const CalibrateArgs& args) {
   options.fit.fit_window_pose = !args.fix_window;
   options.fit.fit_medium_index = args.fit_medium_index;
   options.stage_correction = args.stage_correction;
-  options.cross_validate = args.cross_validate;
+  if (!args.cross_validate.empty() && args.cross_validate != "planes" && args.cross_validate != "points")
+    throw bad_input(fmt::format("--cross-validate={} is invalid: planes (leave one plane out, the default) or points "
+                                "(leave one point out)",
+                                args.cross_validate));
+  options.cross_validate = !args.cross_validate.empty();
+  options.leave_out = args.cross_validate == "points" ? calibration::LeaveOut::point : calibration::LeaveOut::plane;
   options.notice = [](const std::string& text) { fmt::print(stderr, "{}\n", text); };
   const Inputs in = read_inputs(args);
   options.camera_names = in.camera_names;
@@ -410,6 +448,15 @@ void add_calibrate_command(CLI::App& root) {
                   "judged from the target's image growing or shrinking with z)")
       ->capture_default_str();
   cmd->add_option("--corners", args->corners, "Chessboard inner corners NX,NY");
+  cmd->add_option("--lattice", args->lattice,
+                  "Dot lattice: square, or staggered (a second sub-lattice at the cell centres; --spacing is then the "
+                  "row pitch, sqrt(2) times the nearest-dot spacing)")
+      ->capture_default_str();
+  cmd->add_option("--level-offset", args->level_offset_mm,
+                  "Staggered two-level plate: z of the second level's dots relative to the origin's, mm");
+  cmd->add_option("--target-file", args->target_file,
+                  "Target description TOML (kind, pitch_mm, lattice, level_offset_mm, dots, y_axis, origin_mm, corners; "
+                  "docs/calibration.md) instead of the target options");
   cmd->add_option("--max-feature-px", args->max_feature_px,
                   "Dot grid: dots and marker are smaller than this many pixels (0 = 1/8 of the image)")
       ->capture_default_str();
@@ -417,10 +464,13 @@ void add_calibrate_command(CLI::App& root) {
                   "Fewest target points an image must yield; fewer is an error naming camera and plane")
       ->capture_default_str();
   cmd->add_option("--points-out", args->points_out, "Also write the detected points as a correspondence CSV");
+  cmd->add_option("--overlay", args->overlay,
+                  "Target images: write DIR/cam<i>_<z>mm.png per image, the detected points circled, the origin ringed "
+                  "and the +x, +y axes drawn (existing files need --overwrite)");
   cmd->add_option("--models", args->models,
                   "Models to fit, comma-separated: " + fmt::format("{}", fmt::join(calibration::all_camera_model_names(), ",")) +
                       "; each is fitted and reported, the last one is stored; auto: all of them, storing the one with the lowest "
-                      "leave-one-plane-out error")
+                      "cross-validated error (leave one plane out, or one point with --cross-validate=points)")
       ->capture_default_str();
   cmd->add_option("--store", args->store, "Model to store in the calibration file (default: the last of --models)");
   cmd->add_option("--image-size", args->image_size, "Image size W,H in pixels of every camera");
@@ -446,10 +496,16 @@ void add_calibrate_command(CLI::App& root) {
                   "mean and max residuals per camera");
   cmd->add_flag("--overwrite", args->overwrite, "Replace the calibration file if it exists");
   cmd->add_flag("--json", args->json, "Print the report as one JSON object");
-  cmd->add_flag("--cross-validate", args->cross_validate,
-                "Also report each model's leave-one-plane-out error per camera (fit on the other planes, RMS px on the "
-                "plane left out)");
-  cmd->callback([args] { run(*args); });
+  cmd->add_flag("--cross-validate{planes}", args->cross_validate,
+                "Also report each model's cross-validated error per camera: --cross-validate (or =planes) leaves one "
+                "plane out in turn, --cross-validate=points one point (fit on the rest, RMS px on what was left out); "
+                "--models auto uses the same");
+  cmd->callback([args, cmd] {
+    for (const char* name : {"--target", "--spacing", "--dots", "--y-axis", "--corners", "--max-feature-px", "--lattice",
+                             "--level-offset"})
+      if (cmd->get_option(name)->count() > 0) args->target_options.push_back(name);
+    run(*args);
+  });
 }
 
 }  // namespace tomorig::app

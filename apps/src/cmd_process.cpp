@@ -37,7 +37,9 @@ void run(const ProcessArgs& args) {
   hooks.should_stop = [&] { return stop_signal.stop_requested(); };
   hooks.notice = [&](const std::string& text) {
     if (progress) progress->break_line();
-    spdlog::info("{}", text);
+    // A warning of the pipeline (e.g. a poor calibration) stays visible under --quiet.
+    if (text.rfind("warning: ", 0) == 0) spdlog::warn("{}", text.substr(9));
+    else spdlog::info("{}", text);
   };
   hooks.started = [&](std::uint64_t sets_to_do) { progress = std::make_unique<ProgressLine>(sets_to_do); };
   hooks.set_done = [&](const pipeline::BackendSetDone& s) {

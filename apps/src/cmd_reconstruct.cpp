@@ -73,6 +73,7 @@ void run(const ReconstructArgs& args) {
                                 session.set_count() == 0 ? 0 : session.set_count() - 1));
   const pipeline::SessionDescription description = pipeline::describe_session(session);
   const SessionCameras cameras = session_cameras(description, args.calib);
+  for (const std::string& warning : cameras.warnings) fmt::print(stderr, "warning: {}\n", warning);
 
   ReconstructionSetup setup = reconstruction_setup(description, cameras, args.recon);
   const recon::ReconstructionOptions& options = setup.options;

@@ -246,6 +246,7 @@ BackendReport run_backend(const fs::path& session_path, const BackendOptions& op
                      session_path.string(), inputs.processor.reconstruction().algorithm, input.grid.nx, input.grid.ny,
                      input.grid.nz, inputs.processor.cameras().source, input.cameras.size(),
                      report.overlapped ? "reconstruction and correlation overlapped" : "one set at a time"));
+  for (const std::string& warning : inputs.processor.cameras().warnings) notice("warning: " + warning);
   if (hooks.started) hooks.started(todo.size());
 
   std::size_t next = 0;

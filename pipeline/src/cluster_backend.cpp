@@ -313,6 +313,7 @@ BackendReport run_backend_on_mpi(const fs::path& session_path, const BackendOpti
                      session_path.string(), inputs->processor.reconstruction().algorithm, input.grid.nx, input.grid.ny,
                      input.grid.nz, inputs->processor.cameras().source, input.cameras.size(),
                      overlap ? "reconstruction and correlation overlapped on each rank" : "one set at a time per rank"));
+  for (const std::string& warning : inputs->processor.cameras().warnings) notice("warning: " + warning);
   if (hooks.started) hooks.started(todo.size());
 
   // Step 2: rank 0's worker thread beside the coordinator.

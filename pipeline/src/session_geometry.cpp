@@ -114,6 +114,8 @@ SessionCameras calibration_cameras(const SessionDescription& session, const std:
                                   file.string(), c.id, c.image_size.width, c.image_size.height, cam.id, cam.width,
                                   cam.height));
     out.models[static_cast<std::size_t>(c.id)] = c.model;
+    if (const std::string warning = calibration::rms_warning(c); !warning.empty())
+      out.warnings.push_back(fmt::format("calibration file '{}': {}", file.string(), warning));
   }
   return out;
 }

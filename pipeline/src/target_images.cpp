@@ -15,6 +15,7 @@
 
 #include "tomorig/core/error.h"
 #include "tomorig/core/frame_set.h"
+#include "tomorig/processing/calibration/target_overlay.h"
 #include "tomorig/storage/image_file.h"
 #include "tomorig/storage/session_file.h"
 
@@ -276,7 +277,21 @@ TargetImageSet read_session_targets(const fs::path& path, const std::vector<doub
   return set;
 }
 
-DetectedTargets detect_targets(const TargetImageSet& set, const calibration::TargetSpec& spec, int min_points_per_plane) {
+DetectedTargets detect_targets(const TargetImageSet& set, const calibration::TargetSpec& spec, int min_points_per_plane,
+                               const OverlayOutput& overlay) {
+  const auto overlay_file = [&](const TargetImage& image) {
+    return overlay.dir / fmt::format("cam{}_{}mm.png", image.camera, image.z_mm);
+  };
+  if (!overlay.dir.empty()) {
+    std::error_code ec;
+    fs::create_directories(overlay.dir, ec);
+    if (ec || !fs::is_directory(overlay.dir))
+      throw bad_input(fmt::format("--overlay {}: cannot create the folder: {}", overlay.dir.string(), ec.message()));
+    for (const TargetImage& image : set.images)
+      if (!overlay.overwrite && fs::exists(overlay_file(image)))
+        throw bad_input(fmt::format("--overlay {}: {} exists; give --overwrite to replace it, or another folder",
+                                    overlay.dir.string(), overlay_file(image).string()));
+  }
   DetectedTargets out;
   out.table.cameras.resize(set.camera_names.size());
   out.image_sizes.resize(set.camera_names.size());
@@ -329,6 +344,13 @@ DetectedTargets detect_targets(const TargetImageSet& set, const calibration::Tar
                                   "target spec (spacing, polarity) and the image",
                                   what, detection.points.size(), min_points_per_plane));
     out.warnings.insert(out.warnings.end(), detection.warnings.begin(), detection.warnings.end());
+    if (detection.origin_px && detection.x_step_px)
+      out.origins.push_back(fmt::format("{}: origin ({}) at ({:.1f}, {:.1f}) px, +x towards ({:+.1f}, {:+.1f}) px per "
+                                        "pitch, set by {}",
+                                        what, detection.origin_marker, detection.origin_px->x, detection.origin_px->y,
+                                        detection.x_step_px->x, detection.x_step_px->y,
+                                        detection.axis_marker ? "the triangle" : "the image (most nearly to the right)"));
+    if (!overlay.dir.empty()) storage::write_png(overlay_file(image), calibration::draw_detection_overlay(pixels, detection));
     auto& points = out.table.cameras[c];
     points.insert(points.end(), detection.points.begin(), detection.points.end());
   }

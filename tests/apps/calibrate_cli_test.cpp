@@ -356,6 +356,27 @@ TEST_F(CalibrateCli, PinholeWithDistortionReproducesABarrelDistortedRigAtHeldOut
       EXPECT_GT(cv["rms_px"].get<double>(), 0.5) << cv.dump();
     }
   }
+  // Leave one point out: every point is a fold; the lens model stays within a hundredth of a
+  // pixel of points it did not see (its true error is the 0.05 px bound above), the pinhole not.
+  const std::string few = write_points(csv_rows(cameras, {-6, 0, 6}, 20, 5, barrel), "few.csv");
+  const CliResult by_point = run_tomorig("calibrate --points " + few +
+                                         " --models pinhole,pinhole_distortion --cross-validate=points --image-size "
+                                         "2048,2048 --json -o " + shell_quoted((dir_ / "lopo.toml").string()));
+  ASSERT_EQ(by_point.exit_code, 0) << by_point.err;
+  const nlohmann::json lopo = nlohmann::json::parse(by_point.out)["cross_validation"];
+  ASSERT_EQ(lopo.size(), 4u);
+  for (const nlohmann::json& cv : lopo) {
+    EXPECT_EQ(cv["left_out"], "point");
+    EXPECT_EQ(cv["folds"], 3 * 5 * 5);
+    EXPECT_EQ(cv["points"], 3 * 5 * 5);
+    if (cv["model"] == "pinhole_distortion") EXPECT_LT(cv["rms_px"].get<double>(), 0.01) << cv.dump();
+    if (cv["model"] == "pinhole") EXPECT_GT(cv["rms_px"].get<double>(), 0.5) << cv.dump();
+  }
+  const CliResult bad_kind = run_tomorig("calibrate --points " + few + " --cross-validate=lines --image-size 2048,2048 -o " +
+                                         shell_quoted((dir_ / "bad.toml").string()));
+  EXPECT_EQ(bad_kind.exit_code, 2);
+  EXPECT_NE(bad_kind.err.find("--cross-validate=lines is invalid"), std::string::npos) << bad_kind.err;
+
   const nlohmann::json j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j["results"].size(), 4u);
   EXPECT_GT(j["results"][0]["forward_max_px"].get<double>(), 1.0);  // the plain pinhole cannot follow
@@ -450,6 +471,31 @@ TEST_F(CalibrateCli, TheFileDrivesReconstructOnASimulatedSession) {
                                     shell_quoted((dir_ / "v.h5").string()));
   ASSERT_EQ(rec.exit_code, 0) << rec.err;
   EXPECT_EQ(nlohmann::json::parse(rec.out)["volumes"]["a"]["algorithm"], "mlos");
+  EXPECT_EQ(rec.err.find("warning: calibration file"), std::string::npos) << rec.err;
+
+  // A calibration fitted to points a pixel off (RMS above 0.5 px): calibrate warns when it
+  // stores it, and reconstruct and process repeat the warning when they load it.
+  const auto wobble = [](Vec2d p) { return Vec2d{p.x + 1.2 * std::sin(0.37 * p.y), p.y + 1.2 * std::cos(0.29 * p.x)}; };
+  const std::string poor_points = write_points(csv_rows(cameras, {-1.5, -0.5, 0.5, 1.5}, 4.5, 6, wobble), "poor.csv");
+  const std::string poor = (dir_ / "poor.toml").string();
+  const CliResult poor_cal =
+      run_tomorig("calibrate --points " + poor_points + " --models pinhole" + sizes + " -o " + shell_quoted(poor));
+  ASSERT_EQ(poor_cal.exit_code, 0) << poor_cal.err;
+  EXPECT_NE(poor_cal.err.find("warning: camera 0: the stored pinhole model leaves"), std::string::npos) << poor_cal.err;
+  const CliResult poor_rec = run_tomorig("reconstruct --session " + shell_quoted(session) + " --calib " + shell_quoted(poor) +
+                                         " --algorithm mlos --grid 64,64,16,0.0195 -o " +
+                                         shell_quoted((dir_ / "v2.h5").string()));
+  ASSERT_EQ(poor_rec.exit_code, 0) << poor_rec.err;
+  EXPECT_NE(poor_rec.err.find("warning: calibration file '" + poor + "': camera 0: the stored pinhole model leaves"),
+            std::string::npos)
+      << poor_rec.err;
+  EXPECT_NE(poor_rec.err.find("above 0.5 px"), std::string::npos) << poor_rec.err;
+  const CliResult poor_process = run_tomorig("process --session " + shell_quoted(session) + " --calib " + shell_quoted(poor) +
+                                             " --grid 32,32,16,0.0195 --window 16,16,8 --quiet -o " +
+                                             shell_quoted((dir_ / "r.h5").string()));
+  EXPECT_NE(poor_process.err.find("warning: calibration file '" + poor + "': camera 0: the stored pinhole model"),
+            std::string::npos)
+      << poor_process.err;
 }
 
 }  // namespace

@@ -26,30 +26,46 @@ std::vector<PlaneResidual> plane_residuals(const CameraModel& model, std::span<c
 }
 
 CrossValidation cross_validate(const std::string& model, std::span<const PointCorrespondence> points, ImageSize size,
-                               const FitOptions& options, int camera) {
+                               const FitOptions& options, int camera, LeaveOut left_out) {
   CrossValidation cv;
   cv.camera = camera;
   cv.model = model;
-  std::map<double, std::vector<PointCorrespondence>> by_z;
-  for (const auto& p : points) by_z[p.world.z].push_back(p);
+  cv.left_out = left_out;
+  // Folds: the indices of the points left out together (one plane, or one point).
+  std::vector<std::vector<std::size_t>> folds;
+  if (left_out == LeaveOut::plane) {
+    std::map<double, std::vector<std::size_t>> by_z;
+    for (std::size_t k = 0; k < points.size(); ++k) by_z[points[k].world.z].push_back(k);
+    for (auto& [z, indices] : by_z) folds.push_back(std::move(indices));
+  } else {
+    for (std::size_t k = 0; k < points.size(); ++k) folds.push_back({k});
+  }
   double squares = 0;
-  for (const auto& [z, left_out] : by_z) {
+  std::vector<bool> out(points.size(), false);
+  for (const std::vector<std::size_t>& fold : folds) {
+    for (std::size_t k : fold) out[k] = true;
     std::vector<PointCorrespondence> kept;
-    for (const auto& p : points)
-      if (p.world.z != z) kept.push_back(p);
+    kept.reserve(points.size());
+    for (std::size_t k = 0; k < points.size(); ++k)
+      if (!out[k]) kept.push_back(points[k]);
+    for (std::size_t k : fold) out[k] = false;
     try {
       FitReport report;
       const auto fitted = fit_camera_model(model, kept, size, options, report);
-      for (const auto& p : left_out) {
-        const Vec2d u = fitted->project(p.world);
-        const double d = std::hypot(u.x - p.pixel.x, u.y - p.pixel.y);
+      for (std::size_t k : fold) {
+        const Vec2d u = fitted->project(points[k].world);
+        const double d = std::hypot(u.x - points[k].pixel.x, u.y - points[k].pixel.y);
         squares += d * d;
         cv.max_px = std::max(cv.max_px, d);
         ++cv.points;
       }
       ++cv.folds;
     } catch (const Error& e) {
-      cv.error = fmt::format("without plane z = {} mm: {}", z, e.what());
+      const auto& first = points[fold.front()];
+      cv.error = left_out == LeaveOut::plane
+                     ? fmt::format("without plane z = {} mm: {}", first.world.z, e.what())
+                     : fmt::format("without the point ({}, {}, {}) mm: {}", first.world.x, first.world.y, first.world.z,
+                                   e.what());
       return cv;
     }
   }
@@ -76,8 +92,9 @@ AutoChoice choose_model(const std::vector<CrossValidation>& results, const std::
                     "reasons above); list the models with --models");
   std::sort(ranked.begin(), ranked.end());
   AutoChoice choice{ranked.front().second, {}};
-  choice.reason = fmt::format("stored {}: the lowest leave-one-plane-out RMS, {:.4g} px averaged over the cameras", choice.model,
-                              ranked.front().first);
+  const bool by_point = !results.empty() && results.front().left_out == LeaveOut::point;
+  choice.reason = fmt::format("stored {}: the lowest leave-one-{}-out RMS, {:.4g} px averaged over the cameras", choice.model,
+                              by_point ? "point" : "plane", ranked.front().first);
   if (ranked.size() > 1)
     choice.reason += fmt::format(" (next: {} {:.4g} px)", ranked[1].second, ranked[1].first);
   return choice;
@@ -93,15 +110,10 @@ std::string CalibrateCamerasReport::failure_message() const {
                      stored, fmt::join(cameras, ", "));
 }
 
-std::vector<std::string> CalibrateCamerasReport::poor_fit_warnings(double rms_px) const {
+std::vector<std::string> CalibrateCamerasReport::poor_fit_warnings() const {
   std::vector<std::string> out;
   for (const auto& c : calibrations)
-    if (c.report.forward_rms_px > rms_px)
-      out.push_back(fmt::format(
-          "camera {}: the stored {} model leaves {:.3g} px RMS (max {:.3g} px) on its own points, above {} px; "
-          "reconstruction with it will lose or misplace particles: check the points, or fit a model that follows the "
-          "optics (pinhole_distortion, refractive, rational2)",
-          c.id, c.report.model, c.report.forward_rms_px, c.report.forward_max_px, rms_px));
+    if (std::string warning = rms_warning(c); !warning.empty()) out.push_back(std::move(warning));
   return out;
 }
 
@@ -140,7 +152,8 @@ CalibrateCamerasReport calibrate_cameras(std::span<const std::vector<PointCorres
   if (options.cross_validate || options.choose_model) {
     for (std::size_t i = 0; i < points.size(); ++i)
       for (const std::string& model_name : models)
-        out.validation.push_back(cross_validate(model_name, points_of(i), sizes[i], fit_options(i), static_cast<int>(i)));
+        out.validation.push_back(
+            cross_validate(model_name, points_of(i), sizes[i], fit_options(i), static_cast<int>(i), options.leave_out));
     if (options.choose_model) {
       const AutoChoice choice = choose_model(out.validation, models);
       out.stored = choice.model;

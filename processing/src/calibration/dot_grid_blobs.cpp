@@ -2,7 +2,9 @@
 // (a dot is smaller than the structuring element, uneven illumination is not), the result is
 // thresholded by Otsu's method, and each connected component is classified:
 //  - a dot: compact (fills much of its bounding box), not touching the image border;
-//  - the origin marker: a hollow component (a square frame) with a dot inside its box.
+//  - the origin marker: a hollow component (a square frame) with a dot inside its box;
+//  - a filled marker: a solid component clearly larger than a dot that fills its smallest
+//    enclosing rectangle (a square, seen in perspective) or triangle (a triangle).
 // Centres are intensity-weighted centroids of the background-free image over the component
 // grown by two pixels, so the faint rim of a dot counts and the threshold does not bias them.
 #include "dot_grid_blobs.h"
@@ -66,6 +68,42 @@ double axis_ratio(const cv::Mat& labels, const Component& c) {
   return minor > 0 ? std::sqrt(major / minor) : 1e9;
 }
 
+// A filled square or triangle, from the shape of the component's outline: how much of its
+// smallest enclosing rectangle and triangle it fills (a disc fills 0.785 and ~0.6, a square
+// ~1 and 0.5, a triangle ~0.5 and ~1; perspective keeps squares and triangles near 1).
+std::optional<MarkerShape> filled_shape(const cv::Mat& labels, const Component& c) {
+  const cv::Mat mask = labels(c.box) == c.label;
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+  if (contours.size() != 1 || contours[0].size() < 6) return std::nullopt;
+  std::vector<cv::Point2f> outline(contours[0].begin(), contours[0].end());
+  // Pixel outlines run through the edge pixels' centres; half a pixel all round is the area
+  // they leave out, which matters for the marker sizes of a few tens of pixels.
+  const double area = cv::contourArea(outline) + 0.5 * cv::arcLength(outline, true);
+  const cv::RotatedRect rect = cv::minAreaRect(outline);
+  const double rect_area = (rect.size.width + 1.0) * (rect.size.height + 1.0);
+  std::vector<cv::Point2f> triangle;
+  const double triangle_area = cv::minEnclosingTriangle(outline, triangle);
+  if (!(rect_area > 0) || !(triangle_area > 0)) return std::nullopt;
+  const double rect_fill = area / rect_area;
+  const double aspect = std::max(rect.size.width, rect.size.height) / std::max(1.0f, std::min(rect.size.width, rect.size.height));
+
+  const double triangle_fill = area / (triangle_area + 0.5 * cv::arcLength(triangle, true));
+  if (rect_fill > 0.84 && triangle_fill < 0.65 && aspect < 1.8) return MarkerShape::filled_square;
+  if (triangle_fill > 0.76 && rect_fill < 0.65) return MarkerShape::triangle;
+  return std::nullopt;
+}
+
+double solidity(const cv::Mat& labels, const Component& c) {
+  const cv::Mat mask = labels(c.box) == c.label;
+  std::vector<cv::Point> points;
+  cv::findNonZero(mask, points);
+  if (points.size() < 3) return 1;
+  std::vector<cv::Point> hull;
+  cv::convexHull(points, hull);
+  return static_cast<double>(c.area) / (cv::contourArea(hull) + 0.5 * cv::arcLength(hull, true) + 1);
+}
+
 double median(std::vector<double> values) {
   if (values.empty()) return 0;
   std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2), values.end());
@@ -110,7 +148,8 @@ DotBlobs find_dot_blobs(const Image& image, bool white_dots, double max_feature_
       ++border;
       continue;
     }
-    if (c.fill() >= 0.45)
+    // A filled triangle fills at most half its box, like a frame; its outline is convex.
+    if (c.fill() >= 0.45 || (c.box.width >= 5 && c.box.height >= 5 && solidity(labels, c) > 0.85))
       compact.push_back(c);
     else if (c.box.width >= 5 && c.box.height >= 5)
       hollow.push_back(c);
@@ -125,6 +164,12 @@ DotBlobs find_dot_blobs(const Image& image, bool white_dots, double max_feature_
   std::vector<Component> dots;
   int small = 0, large = 0, elongated = 0;
   for (const Component& c : compact) {
+    // Markers are clearly larger than dots (docs/calibration.md: at least twice the area).
+    if (c.area > 1.8 * typical && c.area >= 30)
+      if (const std::optional<MarkerShape> shape = filled_shape(labels, c)) {
+        result.markers.push_back({*shape, weighted_centroid(signal, labels, c, 2), -1});
+        continue;
+      }
     if (c.area < 0.25 * typical || c.area < 2) ++small;
     else if (c.area > 4 * typical) ++large;
     else if (c.area >= 6 && axis_ratio(labels, c) > 2.5) ++elongated;  // two dots run together, or a scratch
@@ -168,8 +213,7 @@ DotBlobs find_dot_blobs(const Image& image, bool white_dots, double max_feature_
     // The same frame found at both thresholds counts once.
     if (std::any_of(seen.begin(), seen.end(), [&](const cv::Rect& r) { return (r & h.box).area() > 0; })) continue;
     seen.push_back(h.box);
-    ++result.markers;
-    result.origin = inside.front();
+    result.markers.push_back({MarkerShape::hollow_square, result.dots[static_cast<std::size_t>(inside.front())], inside.front()});
   }
   return result;
 }

@@ -1,6 +1,7 @@
 #pragma once
 // First stage of dot-grid detection: bright blobs in a (possibly inverted) target image, their
-// sub-pixel centres, and the origin marker (a hollow square framing one dot).
+// sub-pixel centres, and the markers: a hollow square framing the origin dot, a filled square
+// in place of the origin dot, filled triangles in place of dots on the +x axis.
 #include <optional>
 #include <string>
 #include <vector>
@@ -10,10 +11,17 @@
 
 namespace tomorig::calibration::detail {
 
+enum class MarkerShape { hollow_square, filled_square, triangle };
+
+struct FoundMarker {
+  MarkerShape shape = MarkerShape::hollow_square;
+  Vec2d centre;         // hollow: the framed dot's centre; filled: the shape's centroid
+  int framed_dot = -1;  // hollow: index into `dots` of the framed dot
+};
+
 struct DotBlobs {
-  std::vector<Vec2d> dots;         // sub-pixel centres (intensity-weighted centroids)
-  std::optional<int> origin;       // index into `dots` of the dot framed by the marker
-  int markers = 0;                 // hollow squares found (1 when all is well)
+  std::vector<Vec2d> dots;  // sub-pixel centres (intensity-weighted centroids)
+  std::vector<FoundMarker> markers;
   std::vector<std::string> warnings;
 };
 

@@ -61,7 +61,6 @@ void reduce(Vec2d& a, Vec2d& b) {
 
 struct Basis {
   Vec2d ex, ey;
-  std::vector<std::string> warnings;
 };
 
 std::optional<Basis> start_basis(const std::vector<Vec2d>& dots, int origin, bool y_down) {
@@ -87,17 +86,20 @@ std::optional<Basis> start_basis(const std::vector<Vec2d>& dots, int origin, boo
     if (!dots_near(dots, o + 0.5 * *v, r).empty() && !dots_near(dots, o - 0.5 * *v, r).empty()) *v = 0.5 * *v;
   }
   reduce(a, b);
+  // Measured from the dots on both sides where they exist: a target whose dots alternate
+  // between two depth levels shifts every other dot by a parallax p, and the one-sided step
+  // carries p while the half difference of the two sides does not.
+  for (Vec2d* v : {&a, &b}) {
+    const std::vector<int> ahead = dots_near(dots, o + *v, 0.5 * norm(*v)), behind = dots_near(dots, o - *v, 0.5 * norm(*v));
+    if (!ahead.empty() && !behind.empty())
+      *v = 0.5 * (dots[static_cast<std::size_t>(ahead[0])] - dots[static_cast<std::size_t>(behind[0])]);
+  }
 
   Basis basis;
   // +x: the lattice direction most nearly along the image's +u.
   std::vector<Vec2d> candidates = {a, -1.0 * a, b, -1.0 * b};
   std::sort(candidates.begin(), candidates.end(), [](Vec2d l, Vec2d r) { return l.x / norm(l) > r.x / norm(r); });
   basis.ex = candidates[0];
-  const double margin = candidates[0].x / norm(candidates[0]) - candidates[1].x / norm(candidates[1]);
-  if (margin < 0.1)
-    basis.warnings.push_back(
-        "the lattice is turned about 45 degrees in the image, so which lattice direction is +x is nearly ambiguous; "
-        "check the axes of the result");
   basis.ey = std::abs(cross(basis.ex, a)) > std::abs(cross(basis.ex, b)) ? a : b;
   if ((basis.ey.y > 0) != y_down) basis.ey = -1.0 * basis.ey;
   return basis;
@@ -106,20 +108,26 @@ std::optional<Basis> start_basis(const std::vector<Vec2d>& dots, int origin, boo
 }  // namespace
 
 Lattice index_lattice(const std::vector<Vec2d>& dots, int origin, bool y_down) {
-  Lattice lattice;
-  lattice.points.push_back({origin, 0, 0});
   const std::optional<Basis> basis = start_basis(dots, origin, y_down);
   if (!basis) {
+    Lattice lattice;
+    lattice.points.push_back({origin, 0, 0});
     lattice.warnings.push_back("the origin dot has no two independent neighbours; only the origin is identified");
     return lattice;
   }
-  lattice.warnings = basis->warnings;
+  Lattice lattice = grow_lattice(dots, origin, basis->ex, basis->ey, kAmbiguityRadius);
+  return lattice;
+}
 
+Lattice grow_lattice(const std::vector<Vec2d>& dots, int origin, Vec2d ex, Vec2d ey, double ambiguity) {
+  Lattice lattice;
+  lattice.ex = ex;
+  lattice.ey = ey;
   std::map<Site, Identified> sites;
   std::set<Site> rejected;
   std::map<int, Site> owner;       // dot -> site
   std::set<int> conflicted_dots;
-  sites[{0, 0}] = {origin, basis->ex, basis->ey};
+  sites[{0, 0}] = {origin, ex, ey};
   owner[origin] = {0, 0};
   std::deque<Site> queue = {{0, 0}};
 
@@ -131,10 +139,15 @@ Lattice index_lattice(const std::vector<Vec2d>& dots, int origin, bool y_down) {
     for (const auto& [di, dj] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
       const Site t{s.first + di, s.second + dj};
       if (sites.count(t) || rejected.count(t)) continue;
-      const Vec2d step = di != 0 ? static_cast<double>(di) * here.ex : static_cast<double>(dj) * here.ey;
+      Vec2d step = di != 0 ? static_cast<double>(di) * here.ex : static_cast<double>(dj) * here.ey;
+      // The step two sites back along the same line joins sites of the same parities as this
+      // one, so it follows a lattice whose every other dot is shifted (two-level targets).
+      const auto back1 = sites.find({s.first - di, s.second - dj}), back2 = sites.find({s.first - 2 * di, s.second - 2 * dj});
+      if (back1 != sites.end() && back2 != sites.end())
+        step = dots[static_cast<std::size_t>(back1->second.dot)] - dots[static_cast<std::size_t>(back2->second.dot)];
       const Vec2d predicted = p + step;
       const double spacing = std::min(norm(here.ex), norm(here.ey));
-      const std::vector<int> near = dots_near(dots, predicted, kAmbiguityRadius * spacing);
+      const std::vector<int> near = dots_near(dots, predicted, ambiguity * spacing);
       if (near.empty() || norm(dots[static_cast<std::size_t>(near[0])] - predicted) > kAcceptRadius * spacing) continue;
       if (near.size() > 1) {
         rejected.insert(t);
@@ -176,9 +189,6 @@ Lattice index_lattice(const std::vector<Vec2d>& dots, int origin, bool y_down) {
   lattice.points.clear();
   for (const auto& [site, id] : sites)
     if (!conflicted_dots.count(id.dot)) lattice.points.push_back({id.dot, site.first, site.second});
-  const std::size_t unplaced = dots.size() - sites.size();
-  if (unplaced > 0)
-    lattice.warnings.push_back(fmt::format("{} dot(s) not on the lattice grown from the origin left out", unplaced));
   return lattice;
 }
 

@@ -50,6 +50,9 @@ SessionDescription describe_recording(std::string name, std::vector<storage::Ses
 struct SessionCameras {
   std::vector<std::shared_ptr<const calibration::CameraModel>> models;  // session camera order
   std::string source;  // "truth of <session>" or the calibration file, for reports
+  // A loaded calibration whose fit left more than kCalibrationWarnRmsPx: what the commands
+  // using these cameras repeat to their user (the calibration's own warning).
+  std::vector<std::string> warnings;
   std::vector<const calibration::CameraModel*> pointers() const;
 };
 

@@ -48,6 +48,17 @@ struct DetectedTargets {
   CorrespondenceTable table;                       // per camera, all planes
   std::vector<calibration::ImageSize> image_sizes;  // per camera
   std::vector<std::string> warnings;               // from detection, prefixed by camera and plane
+  // Per dot-grid image: where the origin was placed and how ("camera 0, plane z = 1 mm: origin
+  // (filled square) at (201.3, 160.2) px, +x towards (28.1, 3.0) px, set by the triangle").
+  std::vector<std::string> origins;
+};
+
+// Where detect_targets draws what it found (calibration::draw_detection_overlay), one PNG per
+// image named cam<camera>_<z>mm.png; empty: no overlays. Existing files are refused (before any
+// detection) unless `overwrite`.
+struct OverlayOutput {
+  std::filesystem::path dir;
+  bool overwrite = false;
 };
 
 // Detects the target in every image. Throws bad_input naming the camera, the plane and the
@@ -62,6 +73,6 @@ struct DetectedTargets {
 std::string orient_y_axis(DetectedTargets& detected);
 
 DetectedTargets detect_targets(const TargetImageSet& set, const calibration::TargetSpec& spec,
-                               int min_points_per_plane);
+                               int min_points_per_plane, const OverlayOutput& overlay = {});
 
 }  // namespace tomorig::pipeline

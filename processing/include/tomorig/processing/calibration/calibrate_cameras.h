@@ -47,19 +47,24 @@ struct StageOffsets {
   bool converged = false;
 };
 
-// Leave-one-plane-out cross-validation of one model on one camera: each plane in turn is left
-// out, the model fitted to the others and its error measured on the plane left out.
+// Cross-validation of one model on one camera: each plane (or each point) in turn is left out,
+// the model fitted to the others and its error measured on what was left out. Leaving planes
+// out tests the model between and beyond the planes (depth); leaving points out tests it within
+// the calibrated planes, where a plane left out would leave too few planes (2 or 3 planes).
+enum class LeaveOut { plane, point };
+
 struct CrossValidation {
   int camera = 0;
   std::string model;
-  int folds = 0;      // planes left out in turn
+  LeaveOut left_out = LeaveOut::plane;
+  int folds = 0;      // planes (or points) left out in turn
   int points = 0;     // points evaluated (all of them, each once)
-  double rms_px = 0;  // forward residual on the left-out planes
+  double rms_px = 0;  // forward residual on what was left out
   double max_px = 0;
   std::string error;  // why a fold could not be fitted ("" if all could)
 };
 CrossValidation cross_validate(const std::string& model, std::span<const PointCorrespondence> points, ImageSize size,
-                               const FitOptions& options, int camera);
+                               const FitOptions& options, int camera, LeaveOut left_out = LeaveOut::plane);
 
 // The automatic choice: the model whose cross-validated RMS, averaged over the cameras, is
 // lowest among those that every camera could fit; the reason names the runner-up. Throws
@@ -74,7 +79,8 @@ struct CalibrateCamerasOptions {
   std::vector<std::string> models;  // fitted in this order (fit_camera_model() names)
   std::string stored;               // the model whose fits form the calibration; ignored when choosing
   bool choose_model = false;        // cross-validate and store the model with the lowest error
-  bool cross_validate = false;      // report the leave-one-plane-out error of every model
+  bool cross_validate = false;      // report the cross-validated error of every model
+  LeaveOut leave_out = LeaveOut::plane;  // what cross-validation (and the automatic choice) leaves out
   bool stage_correction = false;    // correct the traverse first; the last model comes from the correction
   std::vector<std::string> camera_names;  // one per camera, for the traverse correction's messages
   // For every fit (max_iterations, window, ...); `camera` is set per camera ("camera 0", ...).
@@ -95,9 +101,9 @@ struct CalibrateCamerasReport {
 
   // "no calibration written: the stored model X failed for camera 1, 2 (...)"; "" if none failed.
   std::string failure_message() const;
-  // A stored model that misses its own points by more than `rms_px` will misplace particles:
-  // one warning per such camera.
-  std::vector<std::string> poor_fit_warnings(double rms_px = 0.5) const;
+  // A stored model that misses its own points by more than kCalibrationWarnRmsPx will misplace
+  // particles: one rms_warning() per such camera.
+  std::vector<std::string> poor_fit_warnings() const;
 };
 
 // points[c], sizes[c]: camera c's correspondences and image size. Throws bad_input for options

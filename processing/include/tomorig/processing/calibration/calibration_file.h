@@ -4,6 +4,7 @@
 // projects exactly as it did before saving. Format: docs/calibration.md.
 #include <filesystem>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "tomorig/processing/calibration/camera_model.h"
@@ -17,6 +18,14 @@ struct CameraCalibration {
   std::shared_ptr<const CameraModel> model;
   FitReport report;
 };
+
+// A stored model that misses its own fitted points by more than this RMS will misplace
+// particles; `calibrate` warns when it stores one, `reconstruct` and `process` when they load one.
+inline constexpr double kCalibrationWarnRmsPx = 0.5;
+
+// The warning for `c` ("camera 0: the stored pinhole model leaves 5.5 px RMS ..."), or "" if
+// its RMS (from its fit report) is within kCalibrationWarnRmsPx.
+std::string rms_warning(const CameraCalibration& c);
 
 // Throws tomorig::Error: bad_input if a model is of a kind the file cannot hold, runtime if
 // the file cannot be written.

@@ -2,10 +2,12 @@
 // Calibration targets: what a target looks like (its spec) and what detection found in one
 // image of it at one known z. Detection never guesses: a point it cannot identify with
 // certainty is dropped and named in `warnings`.
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
 
+#include "tomorig/core/geometry.h"
 #include "tomorig/core/image.h"
 #include "tomorig/processing/calibration/fit_types.h"
 
@@ -21,15 +23,31 @@ struct ChessboardSpec {
   double square_mm = 0;
 };
 
-// A regular dot grid with an origin marker (a small square framing the origin dot, as in
-// ../shared/data/fluidimage-tomopiv). Dots may be white on black or black on white.
-// Axes (the marker has no direction, so they follow the image, as fluidimage does): world +x
-// is the lattice direction that points most nearly to the image's right (+u); world +y is the
-// other lattice direction, pointing most nearly down the image (+v) when `y_down`, else up.
-// Every camera must therefore see the target from the same side, without a large roll. The
-// dot at lattice step (i, j) from the origin dot is at world (i * spacing, j * spacing, z).
+// How the dots of a dot target are arranged (docs/calibration.md, "Dot targets").
+enum class DotLattice {
+  square,     // dots at (i, j) * spacing
+  staggered,  // also a second sub-lattice at (i + 1/2, j + 1/2) * spacing, possibly on a second
+              // depth level: seen together, a square lattice turned 45 degrees whose
+              // nearest-dot spacing is spacing / sqrt(2)
+};
+
+// A dot target with an origin marker: either a small hollow square framing the origin dot (as
+// in ../shared/data/fluidimage-tomopiv), or a filled square in place of the origin dot. An
+// optional filled triangle in place of a dot on the origin's level marks the +x axis (it lies
+// at lattice site (k, 0), k > 0, of that level). Dots may be white on black or black on white.
+// Axes without a triangle (the marker has no direction, so they follow the image, as fluidimage
+// does): world +x is the lattice direction that points most nearly to the image's right (+u).
+// In both cases world +y is the other lattice direction, pointing most nearly down the image
+// (+v) when `y_down`, else up. Every camera must see the target from the same side. The dot at
+// lattice step (i, j) from the origin is at world origin_mm + (i * spacing, j * spacing, 0) on
+// the origin's level; a staggered target's second level is at origin_mm + ((i + 1/2) * spacing,
+// (j + 1/2) * spacing, level_offset_mm).
 struct DotGridSpec {
+  // The pitch: distance of neighbouring dots of one level along x and y (the row pitch).
   double spacing_mm = 0;
+  DotLattice lattice = DotLattice::square;
+  double level_offset_mm = 0;  // staggered: z of the second level relative to the origin's
+  Vec3d origin_mm;             // world position of the origin site (z adds to the plane z)
   bool white_dots = true;
   bool y_down = true;
   // Dots and the marker must be smaller than this (pixels) so that the background estimate
@@ -43,6 +61,11 @@ using TargetSpec = std::variant<ChessboardSpec, DotGridSpec>;
 struct TargetDetection {
   std::vector<PointCorrespondence> points;  // world (mm, z = z_mm) and pixel
   std::vector<std::string> warnings;        // points dropped and why
+  // Where the origin and the unit steps along world +x and +y are in the image (px), for the
+  // report and the overlay; unset for a chessboard.
+  std::optional<Vec2d> origin_px, x_step_px, y_step_px;
+  std::string origin_marker;  // "hollow square", "filled square"
+  bool axis_marker = false;   // a triangle fixed +x
 };
 
 // Both throw tomorig::Error (bad_input) naming `what` (e.g. "camera 2, plane z = -3 mm") when
