@@ -2,11 +2,12 @@
 #include "tomorig/processing/calibration/target_file.h"
 
 #include <cmath>
+#include <optional>
 #include <set>
 
 #include <fmt/format.h>
-#include <toml++/toml.h>
 
+#include "tomorig/config/toml_document.h"
 #include "tomorig/core/error.h"
 
 namespace tomorig::calibration {
@@ -14,32 +15,32 @@ namespace {
 
 class Reader {
  public:
-  Reader(const toml::table& t, std::string file) : t_(t), file_(std::move(file)) {}
+  Reader(config::TomlNode t, std::string file) : t_(t), file_(std::move(file)) {}
 
   [[noreturn]] void fail(const std::string& key, const std::string& problem) const {
     throw bad_input(fmt::format("target file {}: {} {}", file_, key, problem));
   }
   double number(const char* key, double fallback) const {
-    const toml::node* n = t_.get(key);
+    const config::TomlNode n = t_[key];
     if (!n) return fallback;
-    const auto v = n->value<double>();
-    if (!n->is_number() || !v || !std::isfinite(*v)) fail(key, "must be a finite number");
+    const auto v = n.as_double();
+    if (!n.is_number() || !v || !std::isfinite(*v)) fail(key, "must be a finite number");
     return *v;
   }
   std::string choice(const char* key, const std::string& fallback, const std::set<std::string>& allowed) const {
-    const toml::node* n = t_.get(key);
+    const config::TomlNode n = t_[key];
     if (!n) return fallback;
-    const auto v = n->value<std::string>();
+    const auto v = n.as_string();
     if (!v || !allowed.count(*v)) fail(key, fmt::format("must be one of: {}", fmt::join(allowed, ", ")));
     return *v;
   }
   std::vector<double> numbers(const char* key, std::size_t size) const {
-    const toml::array* a = t_[key].as_array();
-    if (!a || a->size() != size) fail(key, fmt::format("must be an array of {} numbers", size));
+    const config::TomlNode a = t_[key];
+    if (!a.is_array() || a.size() != size) fail(key, fmt::format("must be an array of {} numbers", size));
     std::vector<double> out;
     for (std::size_t k = 0; k < size; ++k) {
-      const auto v = a->get(k)->value<double>();
-      if (!a->get(k)->is_number() || !v || !std::isfinite(*v)) fail(key, fmt::format("[{}] must be a finite number", k));
+      const auto v = a[k].as_double();
+      if (!a[k].is_number() || !v || !std::isfinite(*v)) fail(key, fmt::format("[{}] must be a finite number", k));
       out.push_back(*v);
     }
     return out;
@@ -47,20 +48,21 @@ class Reader {
   bool has(const char* key) const { return t_.contains(key); }
 
  private:
-  const toml::table& t_;
+  config::TomlNode t_;
   std::string file_;
 };
 
 }  // namespace
 
 TargetFile read_target_file(const std::filesystem::path& path) {
-  toml::table root;
+  if (!std::filesystem::exists(path)) throw bad_input(fmt::format("target file {} does not exist", path.string()));
+  std::optional<config::TomlDocument> document;
   try {
-    root = toml::parse_file(path.string());
-  } catch (const toml::parse_error& e) {
-    if (!std::filesystem::exists(path)) throw bad_input(fmt::format("target file {} does not exist", path.string()));
-    throw bad_input(fmt::format("target file {}: line {}: {}", path.string(), e.source().begin.line, e.description()));
+    document = config::TomlDocument::parse_file(path);
+  } catch (const config::TomlSyntaxError& e) {
+    throw bad_input(fmt::format("target file {}: line {}: {}", path.string(), e.line(), e.description()));
   }
+  const config::TomlNode root = document->root();
   const std::string file = path.string();
   static const std::set<std::string> dot_keys{"kind", "pitch_mm", "lattice", "level_offset_mm", "dots",
                                               "y_axis", "origin_mm", "max_feature_px"};
@@ -69,9 +71,9 @@ TargetFile read_target_file(const std::filesystem::path& path) {
   const std::string kind = r.choice("kind", "", {"dots", "chessboard"});
   if (kind.empty()) r.fail("kind", "is missing: dots or chessboard");
   const auto& known = kind == "dots" ? dot_keys : board_keys;
-  for (const auto& [key, value] : root)
-    if (!known.count(std::string(key.str())))
-      r.fail(std::string(key.str()), fmt::format("is not a key of a {} target; its keys: {}", kind, fmt::join(known, ", ")));
+  for (const auto& [key, value] : root.entries())
+    if (!known.count(key))
+      r.fail(key, fmt::format("is not a key of a {} target; its keys: {}", kind, fmt::join(known, ", ")));
   const double pitch = r.number("pitch_mm", 0);
   if (!(pitch > 0)) r.fail("pitch_mm", "is missing or not > 0: the row pitch (dots) or square size (chessboard), mm");
 
