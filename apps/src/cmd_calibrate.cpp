@@ -23,6 +23,8 @@
 #include "tomorig/pipeline/target_images.h"
 #include "calibrate_report.h"
 #include "commands.h"
+#include "json_summary.h"
+#include "tomorig/core/cli_vocabulary.h"
 #include "tomorig/pipeline/correspondence_csv.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/calibration/calibration_file.h"
@@ -77,7 +79,7 @@ struct CalibrateArgs {
   std::string out;
   std::string check;  // --check CALIB: evaluate a calibration on --points instead of fitting
   bool overwrite = false;
-  bool json = false;
+  JsonOutput json;
   bool cross_validate = false;  // leave one plane out, per camera and model
 };
 
@@ -327,9 +329,11 @@ void run_check(const CalibrateArgs& args) {
     report.retry.clear();
     results.push_back({static_cast<int>(i), report, plane_residuals(*found->model, table.cameras[i])});
   }
-  if (args.json) {
-    fmt::print("{}\n", nlohmann::json{{"check", args.check}, {"points", args.points}, {"results", report_json(results)}}.dump(2));
-    return;
+  if (args.json.wanted()) {
+    nlohmann::json j = json_summary("calibrate");
+    j.update(nlohmann::json{{"check", args.check}, {"points", args.points}, {"results", report_json(results)}});
+    emit_json(args.json, j);
+    if (args.json.to_stdout()) return;
   }
   fmt::print("{} on the points of {} (not fitted: the residuals are its error there)\n", args.check, args.points);
   print_report(results, "", "");
@@ -447,13 +451,15 @@ void run(const CalibrateArgs& args) {
   if (traverse)
     offsets = StageOffsets{traverse->plane_z_mm, traverse->offsets_mm, traverse->per_camera_offsets_mm,
                            in.camera_names, traverse->cycles, traverse->converged};
-  if (args.json) {
-    nlohmann::json j{{"results", report_json(results)}, {"stored", stored}};
+  if (args.json.wanted()) {
+    nlohmann::json j = json_summary("calibrate");
+    j.update(nlohmann::json{{"results", report_json(results)}, {"stored", stored}});
     j["out"] = written.empty() ? nlohmann::json(nullptr) : nlohmann::json(written);
     j["stage_correction"] = offsets ? stage_offsets_json(*offsets) : nlohmann::json(nullptr);
     if (!validation.empty()) j["cross_validation"] = cross_validation_json(validation);
-    fmt::print("{}\n", j.dump(2));
-  } else {
+    emit_json(args.json, j);
+  }
+  if (!args.json.to_stdout()) {
     if (offsets) print_stage_offsets(*offsets);
     print_report(results, stored, written);
     if (!validation.empty()) print_cross_validation(validation);
@@ -481,9 +487,9 @@ void add_calibrate_command(CLI::App& root) {
                   "Target images: a folder with one sub-folder per camera (cam0, cam1, ...) of images named "
                   "<z>mm*.tif, e.g. cam0/-3mm_cam0.tif");
   cmd->add_option("--image-list", args->image_list, "Target images: a CSV with the header camera,z,file (z in mm)");
-  cmd->add_option("--session", args->session,
-                  "Target images: a session file, one set per plane, exposure A of each camera (e.g. from `tomorig "
-                  "simulate --case calib-thesis`); plane z from its truth or --z-list");
+  cli::add_session_argument(*cmd, args->session,
+                            "Target images: a session file, one set per plane, exposure A of each camera (e.g. from "
+                            "`tomorig simulate --case calib-thesis`); plane z from its truth or --z-list");
   cmd->add_option("--z-list", args->z_list, "With --session: the plane z of each set, mm, comma-separated in set order");
   cmd->add_flag("--stage-correction", args->stage_correction,
                 "Correct traverse errors of the target planes (thesis Sect. 6.3.3) before the final fits; prints the "
@@ -532,7 +538,7 @@ void add_calibrate_command(CLI::App& root) {
                   "Evaluate this calibration file on --points (points not used in its fit) instead of fitting: RMS, "
                   "mean and max residuals per camera");
   cmd->add_flag("--overwrite", args->overwrite, "Replace the calibration file if it exists");
-  cmd->add_flag("--json", args->json, "Print the report as one JSON object");
+  add_json_flag(*cmd, args->json);
   cmd->add_flag("--cross-validate", args->cross_validate,
                 "Also report each model's leave-one-plane-out error per camera (fit on the other planes, RMS px on the "
                 "plane left out)");

@@ -33,6 +33,12 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using std::chrono::duration;
 
+// A recorder stops by itself after this long without a set (issue 23: a record after a replay
+// that had ended waited for ever). A rig triggers at 1 Hz or faster, so a minute without a set
+// means the acquisition has stopped; until the first set, the minute also covers the start of
+// the sender. --idle-timeout 0 waits for ever (e.g. for a run started by hand later).
+constexpr double kDefaultIdleTimeoutSeconds = 60.0;
+
 struct RecordArgs {
   std::string from = "tcp://127.0.0.1:5555";
   bool bind = false;
@@ -40,7 +46,7 @@ struct RecordArgs {
   std::string token;
   std::optional<std::uint64_t> sets;
   std::string compression = "none";
-  std::optional<double> idle_timeout_s;
+  double idle_timeout_s = kDefaultIdleTimeoutSeconds;  // 0: wait for ever
   JsonOutput json;
   rig::RecorderOptions recorder;  // out, overwrite and disk_reserve_mb bound directly
 };
@@ -83,8 +89,9 @@ class RecordStatus {
 
 void record(const RecordArgs& args) {
   if (args.sets && *args.sets < 1) throw bad_input("--sets 0 is invalid: record at least one set (or omit --sets)");
-  if (args.idle_timeout_s && !(*args.idle_timeout_s > 0.0))
-    throw bad_input(fmt::format("--idle-timeout {:g} is invalid: it must be > 0 seconds", *args.idle_timeout_s));
+  if (!(args.idle_timeout_s >= 0.0))
+    throw bad_input(fmt::format("--idle-timeout {:g} is invalid: give seconds >= 0 (0: wait for ever)",
+                                args.idle_timeout_s));
   rig::RecorderOptions options = args.recorder;
   options.compression = rig::parse_compression_option(args.compression);
   rig::prepare_output(options);
@@ -155,8 +162,8 @@ void record(const RecordArgs& args) {
       continue;
     }
     if (!message) {
-      if (args.idle_timeout_s && duration<double>(Clock::now() - last_arrival).count() >= *args.idle_timeout_s) {
-        stopped_by = fmt::format("no set for {:g} s (--idle-timeout)", *args.idle_timeout_s);
+      if (args.idle_timeout_s > 0 && duration<double>(Clock::now() - last_arrival).count() >= args.idle_timeout_s) {
+        stopped_by = fmt::format("no set for {:g} s (--idle-timeout)", args.idle_timeout_s);
         break;
       }
       update(false);
@@ -291,7 +298,10 @@ void add_record_command(CLI::App& root) {
   cmd->add_option("--sets", args->sets, "Stop after this many sets (default: at the sender's end of acquisition, Ctrl-C or --idle-timeout)");
   cmd->add_option("--compression", args->compression, "Frame compression: none | bitshuffle-lz4")
       ->capture_default_str();
-  cmd->add_option("--idle-timeout", args->idle_timeout_s, "Stop when no set arrived for this many seconds");
+  cmd->add_option("--idle-timeout", args->idle_timeout_s,
+                  "Stop when no set arrived for this many seconds (counted from the start until the first set); 0: "
+                  "wait for ever")
+      ->capture_default_str();
   cmd->add_flag("--overwrite", args->recorder.overwrite, "Replace an existing output file");
   cmd->add_option("--disk-reserve-mb", args->recorder.disk_reserve_mb,
                   "Stop recording cleanly when the disk would have less than this many MB free")

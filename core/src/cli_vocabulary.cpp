@@ -1,5 +1,7 @@
 #include "tomorig/core/cli_vocabulary.h"
 
+#include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <mutex>
@@ -37,7 +39,7 @@ double parse_duration_ns(std::string_view text, std::string_view option) {
   if (unit.empty()) throw fail("the unit is missing");
   const std::optional<double> scale = unit_ns(unit);
   if (!scale) throw fail(fmt::format("unknown unit '{}'", unit));
-  if (value <= 0) throw fail("it must be > 0");
+  if (value < 0) throw fail("it must not be negative");
   return value * *scale;
 }
 
@@ -70,15 +72,34 @@ void add_dt_option(CLI::App& cmd, std::optional<double>& dt_ns, const std::strin
            name,
            [&dt_ns, name, scale](double v) {
              warn_deprecated(name, "--dt with a unit (e.g. --dt 80us)");
-             if (!(v > 0) || !std::isfinite(v))
-               throw bad_input(fmt::format("{} {} must be > 0 (better: --dt with a unit, e.g. --dt 80us)", name, v));
-             dt_ns = v * scale;
+             dt_ns = v * scale;  // the command checks the value, as for --dt
            },
            "deprecated: use --dt")
         ->group("");
   };
   legacy("--dt-us", 1e3);
   legacy("--dt-ns", 1.0);
+}
+
+std::vector<std::string> apply_json_value_rule(std::vector<std::string> args) {
+  const auto names_json_file = [](const std::string& a) {
+    if (a == "-") return true;
+    if (a.size() < 5) return false;
+    std::string tail = a.substr(a.size() - 5);
+    for (char& c : tail) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return tail == ".json";
+  };
+  for (std::size_t i = 0; i + 1 < args.size(); ++i) {
+    if (args[i] == "--") break;
+    if (args[i] != "--json") continue;
+    const std::string& next = args[i + 1];
+    if ((!next.empty() && next.front() == '-') || names_json_file(next)) continue;
+    args.erase(args.begin() + static_cast<std::ptrdiff_t>(i));
+    const auto end = std::find(args.begin(), args.end(), std::string("--"));
+    args.insert(end, "--json");
+    break;
+  }
+  return args;
 }
 
 }  // namespace tomorig::cli

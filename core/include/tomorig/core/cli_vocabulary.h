@@ -6,12 +6,13 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 namespace tomorig::cli {
 
-// "80us", "1.5ms", "200ns", "80 µs", "0.001s" -> nanoseconds (> 0). A number without a unit is
+// "80us", "1.5ms", "200ns", "80 µs", "0.001s" -> nanoseconds (>= 0; 0 is left to the command). A number without a unit is
 // refused (was it µs or ns?). Throws tomorig::Error (bad_input) naming `option`.
 double parse_duration_ns(std::string_view text, std::string_view option = "--dt");
 
@@ -40,5 +41,12 @@ void require_session(const std::string& session, std::string_view command);
 // --dt with units ("80us"), and the old --dt-us / --dt-ns (plain numbers) as deprecated aliases;
 // `dt_ns` is set to the value in nanoseconds when any is given.
 void add_dt_option(CLI::App& cmd, std::optional<double>& dt_ns, const std::string& help);
+
+// `--json [FILE]`: the word after --json is its FILE only when it names a .json file (or is
+// "-", stdout); otherwise it is the command's own argument, as in `tomorig inspect --json s.h5`,
+// and --json is moved to the end of the command line, where it takes no value. `--json=FILE`
+// always names a file. Applied to the whole command line (without the program name) before
+// parsing.
+std::vector<std::string> apply_json_value_rule(std::vector<std::string> args);
 
 }  // namespace tomorig::cli
