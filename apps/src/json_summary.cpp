@@ -13,7 +13,8 @@ void add_json_flag(CLI::App& cmd, JsonOutput& out) {
   out.flag = cmd.add_option("--json", out.file,
                             "Print the summary as one JSON object on stdout (and nothing else there), or write "
                             "it to FILE (.json, or --json=FILE)")
-                 ->expected(0, 1);
+                 ->expected(0, 1)
+                 ->type_name("[FILE]");
 }
 
 nlohmann::json json_summary(const std::string& command) { return {{json_key::kCommand, command}}; }

@@ -32,7 +32,7 @@ class ConsoleCli : public ::testing::Test {
     if (!tomorig_built()) GTEST_SKIP() << "tomorig binary not built";
   }
   static std::string process(const std::string& out, const std::string& extra = "") {
-    return "process --session " + shell_quoted(session_) + " --calib truth --grid 32,32,48,0.0195 --window 16,16,16 "
+    return "process " + shell_quoted(session_) + " --calib truth --grid 32,32,48,0.0195 --window 16,16,16 "
            "--overlap 0.5 --deformation-passes 1 -o " + shell_quoted((*dir_ / out).string()) + " " + extra;
   }
   static std::unique_ptr<TempDir> dir_;
@@ -157,7 +157,7 @@ TEST_F(ConsoleCli, TooLargeWindowIsNamedAsTheUserWroteIt) {
 // the same meaning: stdout alone, or the file with the text kept on stdout.
 TEST_F(ConsoleCli, ProcessInspectAndReconstructTakeJsonFile) {
   const fs::path pj = *dir_ / "process.json";
-  const CliResult p = run_tomorig(process("pj.h5", "--json " + shell_quoted(pj.string())));
+  const CliResult p = run_tomorig(process("process-json.h5", "--json " + shell_quoted(pj.string())));
   ASSERT_EQ(p.exit_code, 0) << p.err;
   EXPECT_NE(p.out.find("wrote "), std::string::npos) << p.out;
   std::ifstream process_in(pj);
