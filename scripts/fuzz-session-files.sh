@@ -8,7 +8,7 @@
 #   preprocess                           read every set and write a new session
 #   replay (into a tomorig record)       read and stream every set
 #   reconstruct --grid 16,12,8           a tiny reconstruction of set 0
-#   process --grid 16,12,8 --max-sets 1  reconstruction and correlation into a results file
+#   process --grid 16,12,8 --sets 1      reconstruction and correlation into a results file
 # Every run must exit 0 or 2: a signal, a timeout or another exit code is counted as a failure
 # and its file is kept in the work folder. Counts only, no timings: safe on a loaded machine.
 #
@@ -101,10 +101,10 @@ run_command() {
   case $k in
     0) check "$label" inspect --json damaged.h5 ;;
     1) check "$label" inspect damaged.h5 --png png --set 1 ;;
-    2) check "$label" preprocess --session damaged.h5 --chain chain.toml -o out.h5 ;;
+    2) check "$label" preprocess damaged.h5 --chain chain.toml -o out.h5 ;;
     3) replay_into_record "$label" ;;
-    4) check "$label" reconstruct --session damaged.h5 --calib truth --grid 16,12,8,0.6 --set 0 --threads 1 -o vol.h5 ;;
-    5) check "$label" process --session damaged.h5 --calib truth --grid 16,12,8,0.6 --window 8,8,8 --max-sets 1 \
+    4) check "$label" reconstruct damaged.h5 --calib truth --grid 16,12,8,0.6 --set 0 --threads 1 -o vol.h5 ;;
+    5) check "$label" process damaged.h5 --calib truth --grid 16,12,8,0.6 --window 8,8,8 --sets 1 \
          --threads 1 -o res.h5 ;;
   esac
 }

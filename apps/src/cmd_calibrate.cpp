@@ -23,6 +23,8 @@
 #include "tomorig/pipeline/target_images.h"
 #include "calibrate_report.h"
 #include "commands.h"
+#include "json_summary.h"
+#include "tomorig/core/cli_vocabulary.h"
 #include "tomorig/pipeline/correspondence_csv.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/calibration/calibration_file.h"
@@ -83,7 +85,7 @@ struct CalibrateArgs {
   std::string out;
   std::string check;  // --check CALIB: evaluate a calibration on --points instead of fitting
   bool overwrite = false;
-  bool json = false;
+  JsonOutput json;
   std::string cross_validate;  // "", "planes" (leave one plane out) or "points" (one point), per camera and model
 };
 
@@ -358,9 +360,11 @@ void run_check(const CalibrateArgs& args) {
     report.retry.clear();
     results.push_back({static_cast<int>(i), report, calibration::plane_residuals(*found->model, table.cameras[i])});
   }
-  if (args.json) {
-    fmt::print("{}\n", nlohmann::json{{"check", args.check}, {"points", args.points}, {"results", report_json(results)}}.dump(2));
-    return;
+  if (args.json.wanted()) {
+    nlohmann::json j = json_summary("calibrate");
+    j.update(nlohmann::json{{"check", args.check}, {"points", args.points}, {"results", report_json(results)}});
+    emit_json(args.json, j);
+    if (args.json.to_stdout()) return;
   }
   fmt::print("{} on the points of {} (not fitted: the residuals are its error there)\n", args.check, args.points);
   print_report(results, "", "");
@@ -407,13 +411,15 @@ void run(const CalibrateArgs& args) {
   if (!result.stored_failure) calibration::save_calibration(args.out, result.calibrations);
   for (const std::string& warning : result.poor_fit_warnings()) fmt::print(stderr, "warning: {}\n", warning);
   const std::string written = result.stored_failure ? std::string() : args.out;
-  if (args.json) {
-    nlohmann::json j{{"results", report_json(result.results)}, {"stored", result.stored}};
+  if (args.json.wanted()) {
+    nlohmann::json j = json_summary("calibrate");
+    j.update(nlohmann::json{{"results", report_json(result.results)}, {"stored", result.stored}});
     j["out"] = written.empty() ? nlohmann::json(nullptr) : nlohmann::json(written);
     j["stage_correction"] = result.offsets ? stage_offsets_json(*result.offsets) : nlohmann::json(nullptr);
     if (!result.validation.empty()) j["cross_validation"] = cross_validation_json(result.validation);
-    fmt::print("{}\n", j.dump(2));
-  } else {
+    emit_json(args.json, j);
+  }
+  if (!args.json.to_stdout()) {
     if (result.offsets) print_stage_offsets(*result.offsets);
     print_report(result.results, result.stored, written);
     if (!result.validation.empty()) print_cross_validation(result.validation);
@@ -432,9 +438,9 @@ void add_calibrate_command(CLI::App& root) {
                   "Target images: a folder with one sub-folder per camera (cam0, cam1, ...) of images named "
                   "<z>mm*.tif, e.g. cam0/-3mm_cam0.tif");
   cmd->add_option("--image-list", args->image_list, "Target images: a CSV with the header camera,z,file (z in mm)");
-  cmd->add_option("--session", args->session,
-                  "Target images: a session file, one set per plane, exposure A of each camera (e.g. from `tomorig "
-                  "simulate --case calib-thesis`); plane z from its truth or --z-list");
+  cli::add_session_argument(*cmd, args->session,
+                            "Target images: a session file, one set per plane, exposure A of each camera (e.g. from "
+                            "`tomorig simulate --case calib-thesis`); plane z from its truth or --z-list");
   cmd->add_option("--z-list", args->z_list, "With --session: the plane z of each set, mm, comma-separated in set order");
   cmd->add_flag("--stage-correction", args->stage_correction,
                 "Correct traverse errors of the target planes (thesis Sect. 6.3.3) before the final fits; prints the "
@@ -495,7 +501,7 @@ void add_calibrate_command(CLI::App& root) {
                   "Evaluate this calibration file on --points (points not used in its fit) instead of fitting: RMS, "
                   "mean and max residuals per camera");
   cmd->add_flag("--overwrite", args->overwrite, "Replace the calibration file if it exists");
-  cmd->add_flag("--json", args->json, "Print the report as one JSON object");
+  add_json_flag(*cmd, args->json);
   cmd->add_flag("--cross-validate{planes}", args->cross_validate,
                 "Also report each model's cross-validated error per camera: --cross-validate (or =planes) leaves one "
                 "plane out in turn, --cross-validate=points one point (fit on the rest, RMS px on what was left out); "

@@ -9,6 +9,7 @@
 #include <fmt/core.h>
 
 #include "commands.h"
+#include "tomorig/core/cli_vocabulary.h"
 #include "json_summary.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
@@ -21,7 +22,7 @@ struct ImportArgs {
   std::vector<std::string> cameras;  // "ID=PATTERN"
   std::string pairing = "auto";
   JsonOutput json;
-  double dt_us = 0.0;
+  std::optional<double> dt_ns;  // --dt (0: unknown); none: the rig config's
   double pixel_pitch_um = 0.0;
   double rate_hz = 0.0;
   std::string config;
@@ -29,7 +30,6 @@ struct ImportArgs {
   bool overwrite = false;
   std::string out;
   // Set while registering: whether a flag was given, so it can override the rig config.
-  CLI::Option* dt_flag = nullptr;
   CLI::Option* pitch_flag = nullptr;
   CLI::Option* rate_flag = nullptr;
 };
@@ -47,7 +47,7 @@ storage::ImportCamera parse_camera(const std::string& spec) {
 // Takes Δt, rate and pixel pitches from the rig file for whatever the flags leave open.
 void apply_rig(const config::RigConfig& rig, const std::string& origin, storage::ImportOptions& o,
                const ImportArgs& args) {
-  if (!*args.dt_flag) o.dt_us = rig.trigger.dt_us;
+  if (!args.dt_ns) o.dt_us = rig.trigger.dt_us;
   if (!*args.rate_flag) o.rate_hz = rig.trigger.rate_hz;
   o.rig_config_toml = rig.source_text;
   for (auto& camera : o.cameras) {
@@ -71,14 +71,15 @@ void run_import(const ImportArgs& args) {
   o.pairing = *pairing;
   o.writer.compression = *compression;
   o.writer.overwrite = args.overwrite;
-  o.dt_us = args.dt_us;
+  o.dt_us = args.dt_ns.value_or(0.0) * 1e-3;
   o.rate_hz = args.rate_hz;
   for (auto& camera : o.cameras) camera.pixel_pitch_um = args.pixel_pitch_um;
   if (!args.config.empty()) {
     apply_rig(config::load_rig_config(args.config), args.config, o, args);
-  } else if (!*args.dt_flag) {
+  } else if (!args.dt_ns) {
     // A session without Δt cannot give velocities; make the user say so explicitly.
-    throw bad_input("import needs the pulse separation: pass --dt-us (0 if unknown) or --config RIG.toml");
+    throw bad_input("import needs the pulse separation: pass --dt with its unit (e.g. --dt 80us; --dt 0us if unknown) "
+                    "or --config RIG.toml");
   }
 
   const storage::ImportResult result = storage::import_images(o, args.out);
@@ -129,7 +130,7 @@ void add_import_command(CLI::App& root) {
                   "every file name ends in a/b)")
       ->check(CLI::IsMember({"auto", "name", "order"}))
       ->capture_default_str();
-  args->dt_flag = cmd->add_option("--dt-us", args->dt_us, "Pulse separation A -> B in microseconds (0 = unknown)");
+  cli::add_dt_option(*cmd, args->dt_ns, "Pulse separation A -> B, 0us if unknown");
   args->pitch_flag = cmd->add_option("--pixel-pitch-um", args->pixel_pitch_um, "Sensor pixel pitch in micrometres");
   args->rate_flag = cmd->add_option("--rate-hz", args->rate_hz,
                                     "Trigger rate, to give sets timestamps i / rate (0 = unknown: all at t = 0)");

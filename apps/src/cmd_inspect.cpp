@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "json_summary.h"
 #include "tomorig/core/error.h"
 #include "tomorig/pipeline/quicklook_history.h"
 #include "tomorig/processing/quicklook/display.h"
@@ -21,7 +22,7 @@ namespace {
 
 struct InspectArgs {
   std::string file;
-  bool json = false;
+  JsonOutput json;
   std::string png_folder;
   std::uint64_t set = 0;
 };
@@ -133,8 +134,8 @@ void print_text(const storage::SessionSummary& s) {
 void add_inspect_command(CLI::App& root) {
   auto args = std::make_shared<InspectArgs>();
   CLI::App* cmd = root.add_subcommand("inspect", "Summarise a session file: cameras, sets, timing, missing frames, quick-look history");
-  cmd->add_option("file", args->file, "Session file (.h5)")->required();
-  cmd->add_flag("--json", args->json, "Print one JSON object instead of text");
+  cmd->add_option("session", args->file, "Session file (.h5)")->required()->type_name("SESSION");
+  add_json_flag(*cmd, args->json);
   cmd->add_option("--png", args->png_folder,
                   "Also write 8-bit PNG quick-looks of one set's frames into this folder (created if needed)");
   cmd->add_option("--set", args->set, "Set for --png, 0-based")->capture_default_str();
@@ -144,15 +145,17 @@ void add_inspect_command(CLI::App& root) {
     const pipeline::QuickLookHistory history = pipeline::quicklook_history(reader);
     std::vector<std::filesystem::path> pngs;
     if (!args->png_folder.empty()) pngs = write_quicklooks(reader, args->set, args->png_folder);
-    if (args->json) {
-      nlohmann::json j = to_json(summary);
+    if (args->json.wanted()) {
+      nlohmann::json j = json_summary("inspect");
+      j.update(to_json(summary));
       j["quicklook"] = pipeline::to_json(history);
       if (!args->png_folder.empty()) {
         j["quicklooks"] = nlohmann::json::array();
         for (const auto& p : pngs) j["quicklooks"].push_back(p.string());
       }
-      fmt::print("{}\n", j.dump(2));
-    } else {
+      emit_json(args->json, j);
+    }
+    if (!args->json.to_stdout()) {
       print_text(summary);
       fmt::print("{}", history.sets > 0 ? pipeline::history_text(history)
                                         : std::string("quick-look   none stored (recorded without a quick-look stage)\n"));

@@ -14,6 +14,8 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "json_summary.h"
+#include "tomorig/core/cli_vocabulary.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/optics/droplet_image.h"
 #include "tomorig/processing/optics/edge_psf.h"
@@ -27,12 +29,20 @@
 namespace tomorig::app {
 namespace {
 
+// { "command": NAME } followed by the command's own keys.
+nlohmann::json with_command(const std::string& name, const nlohmann::json& keys) {
+  nlohmann::json j = json_summary(name);
+  j.update(keys);
+  return j;
+}
+
 struct OpticsArgs {
   std::string setup;
   double f_number = 0, magnification = 0, noise = 0, threshold = 0;
   std::string chi, liquid = "kerosene", led, diameters;
   std::string png;
-  bool json = false, overwrite = false;
+  JsonOutput json;
+  bool overwrite = false;
   CLI::Option *f_opt = nullptr, *m_opt = nullptr, *noise_opt = nullptr, *threshold_opt = nullptr, *chi_opt = nullptr,
               *liquid_opt = nullptr, *led_opt = nullptr;
 };
@@ -136,7 +146,7 @@ void run_visibility(const OpticsArgs& a) {
   const optics::VisibilitySetup s = setup_from(a, true);
   const std::vector<optics::VisibilityRow> rows = optics::visibility_table(s);
   if (!a.png.empty()) storage::write_png(a.png, optics::visibility_plot(s, rows));
-  if (a.json) {
+  if (a.json.wanted()) {
     nlohmann::json j = setup_json(s);
     j["d_max_um"] = s.d_max_um;
     nlohmann::json out_rows = nlohmann::json::array();
@@ -148,8 +158,8 @@ void run_visibility(const OpticsArgs& a) {
     }
     j["rows"] = out_rows;
     if (!a.png.empty()) j["png"] = a.png;
-    fmt::print("{}\n", j.dump(2));
-    return;
+    emit_json(a.json, with_command("optics visibility", j));
+    if (a.json.to_stdout()) return;
   }
   fmt::print("smallest visible droplet [um], {} in LED light {:g} nm ({:g} nm FWHM); threshold 1 - 2 sigma\n",
              s.liquid.name, s.spectrum.peak_nm, s.spectrum.fwhm_nm);
@@ -178,7 +188,7 @@ void run_transmission(const OpticsArgs& a) {
   const bool with_chi = a.chi_opt->count() > 0 || !a.setup.empty();
   const double chi = c.chi.front().chi_um;
   nlohmann::json rows = nlohmann::json::array();
-  if (!a.json)
+  if (!a.json.to_stdout())
     fmt::print("{} in LED light {:g} nm ({:g} nm FWHM), f/{:g}, M {:g}, NA {:.4f}{}\n{:>8} {:>8}{}\n", s.liquid.name,
                s.spectrum.peak_nm, s.spectrum.fwhm_nm, c.f_number, c.magnification, na,
                with_chi ? fmt::format(", chi {:g} um", chi) : "", "d [um]", "tau", with_chi ? fmt::format(" {:>8}", "i_min") : "");
@@ -186,13 +196,13 @@ void run_transmission(const OpticsArgs& a) {
     const double tau = model.transmission(d, na);
     const double imin = with_chi ? optics::minimum_intensity(d, chi, tau) : std::nan("");
     rows.push_back({{"d_um", d}, {"tau", tau}, {"i_min", finite_or_null(imin)}});
-    if (!a.json) fmt::print("{:>8g} {:>8.4f}{}\n", d, tau, with_chi ? fmt::format(" {:>8.4f}", imin) : "");
+    if (!a.json.to_stdout()) fmt::print("{:>8g} {:>8.4f}{}\n", d, tau, with_chi ? fmt::format(" {:>8.4f}", imin) : "");
   }
-  if (a.json) {
+  if (a.json.wanted()) {
     nlohmann::json j = setup_json(s);
     j["chi_um"] = with_chi ? nlohmann::json(chi) : nlohmann::json(nullptr);
     j["rows"] = rows;
-    fmt::print("{}\n", j.dump(2));
+    emit_json(a.json, with_command("optics transmission", j));
   }
 }
 
@@ -200,7 +210,8 @@ struct PsfArgs {
   std::string session, z, magnification;
   std::string setup_out, noise, liquid = "kerosene";
   double f_number = 0;
-  bool json = false, overwrite = false;
+  JsonOutput json;
+  bool overwrite = false;
 };
 
 double object_pixel_um(const storage::SessionReader& reader, const std::vector<double>& magnification, std::size_t c,
@@ -249,6 +260,7 @@ void run_psf(const PsfArgs& a) {
       throw bad_input("--setup-out needs --f-number and --noise (sigma of the flat-fielded bright field, one or one "
                       "per camera) to describe the cameras");
   }
+  cli::require_session(a.session, "optics psf");
   const storage::SessionReader reader(a.session);
   const std::size_t sets = reader.set_count(), cams = reader.info().cameras.size();
   if (sets == 0) throw bad_input(fmt::format("session '{}' has no sets: record one target image per depth", a.session));
@@ -296,15 +308,15 @@ void run_psf(const PsfArgs& a) {
     out << text;
     if (!out) throw runtime_error(fmt::format("writing '{}' failed (is the disk full?)", a.setup_out));
   }
-  if (a.json) {
+  if (a.json.wanted()) {
     nlohmann::json out = nlohmann::json::array();
     for (std::size_t c = 0; c < cams; ++c) {
       nlohmann::json values = nlohmann::json::array();
       for (double v : chi[c]) values.push_back(finite_or_null(v));
       out.push_back({{"id", reader.info().cameras[c].id}, {"z_mm", z}, {"chi_um", values}, {"edges", edges[c]}});
     }
-    fmt::print("{}\n", nlohmann::json{{"session", a.session}, {"cameras", out}}.dump(2));
-    return;
+    emit_json(a.json, with_command("optics psf", nlohmann::json{{"session", a.session}, {"cameras", out}}));
+    if (a.json.to_stdout()) return;
   }
   fmt::print("PSF half-width chi [um] from edges (knife-edge, Gaussian fit of the line spread)\n{:>8}", "z [mm]");
   for (std::size_t c = 0; c < cams; ++c) fmt::print(" {:>8}", reader.info().cameras[c].id);
@@ -325,7 +337,7 @@ void add_common(CLI::App* cmd, OpticsArgs& a) {
   a.threshold_opt = cmd->add_option("--threshold", a.threshold, "threshold of visibility instead of --noise (1 - 2 sigma)");
   a.liquid_opt = cmd->add_option("--liquid", a.liquid, "water or kerosene (default kerosene, or the set-up's)");
   a.led_opt = cmd->add_option("--led", a.led, "LED spectrum PEAK_NM:FWHM_NM (default 514:37)");
-  cmd->add_flag("--json", a.json, "print JSON instead of a table");
+  add_json_flag(*cmd, a.json);
 }
 
 }  // namespace
@@ -353,12 +365,11 @@ void add_optics_command(CLI::App& root) {
   auto psf = std::make_shared<PsfArgs>();
   CLI::App* p = optics_cmd->add_subcommand("psf", "PSF half-width chi per camera and depth from edge-target images "
                                                   "(knife-edge technique, Sect. 6.4)");
-  p->add_option("--session", psf->session, "session with one set per depth, each camera's target image in exposure A")
-      ->required();
+  cli::add_session_argument(*p, psf->session, "session with one set per depth, each camera's target image in exposure A");
   p->add_option("--z", psf->z, "depth of each set in mm, comma-separated (default: the session truth's planes)");
   p->add_option("--magnification", psf->magnification,
                 "magnification, one or one per camera (default: from the session's truth cameras)");
-  p->add_flag("--json", psf->json, "print JSON instead of a table");
+  add_json_flag(*p, psf->json);
   p->add_option("--setup-out", psf->setup_out, "also write the result as an optics set-up file (TOML) for "
                                                "`optics visibility --setup`");
   p->add_option("--f-number", psf->f_number, "--setup-out: the lenses' f-number");

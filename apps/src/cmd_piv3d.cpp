@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -11,6 +12,8 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "json_summary.h"
+#include "tomorig/core/cli_vocabulary.h"
 #include "tomorig/pipeline/correlation_args.h"
 #include "tomorig/core/error.h"
 #include "tomorig/storage/output_path.h"
@@ -32,10 +35,10 @@ struct Piv3dArgs {
   std::string name_a = "a";
   std::string name_b = "b";
   std::string out;
-  std::int64_t dt_ns = 0;
+  std::optional<double> dt_ns;  // --dt; none: the volume file's
   int threads = 0;
   bool overwrite = false;
-  bool json = false;
+  JsonOutput json;
   CorrelationArgs correlation;
 };
 
@@ -72,12 +75,12 @@ void run(const Piv3dArgs& args) {
                                 args.name_a, ga.nx, ga.ny, ga.nz, ga.voxel_size, name_b, gb.nx, gb.ny, gb.nz,
                                 gb.voxel_size));
 
-  std::int64_t dt = args.dt_ns;
-  if (dt < 0) throw bad_input(fmt::format("--dt-ns {} must be > 0", dt));
+  std::int64_t dt = static_cast<std::int64_t>(std::llround(args.dt_ns.value_or(0.0)));
+  if (dt < 0) throw bad_input(fmt::format("--dt {}ns must be > 0", dt));
   if (dt == 0) dt = recorded_dt_ns(file_a);
   if (dt <= 0)
     throw bad_input(fmt::format("volume file '{}' records no pulse separation (dt = 0 or missing), so velocities "
-                                "cannot be computed; give it with --dt-ns",
+                                "cannot be computed; give it with --dt (e.g. --dt 80us)",
                                 args.volumes));
 
   CorrelationArgs corr_args = args.correlation;
@@ -111,12 +114,13 @@ void run(const Piv3dArgs& args) {
                                 {.overwrite = args.overwrite});
   writer.add(result);
   writer.close();
-  const nlohmann::json summary = {{"out", args.out},
-                                  {"xdmf", storage::ResultsWriter::sidecar_path(args.out).string()},
-                                  {"nodes", {result.field.nx, result.field.ny, result.field.nz}},
-                                  {"correlation", to_json(report)}};
-  if (args.json) fmt::print("{}\n", summary.dump(2));
-  else
+  nlohmann::json summary = json_summary("piv3d");
+  summary.update(nlohmann::json{{"out", args.out},
+                                {"xdmf", storage::ResultsWriter::sidecar_path(args.out).string()},
+                                {"nodes", {result.field.nx, result.field.ny, result.field.nz}},
+                                {"correlation", to_json(report)}});
+  emit_json(args.json, summary);
+  if (!args.json.to_stdout())
     fmt::print("wrote {} and {}: {} vectors, {:.1f} % valid, {} replaced, {} invalid, {:.1f} s\n", args.out,
                summary["xdmf"].get<std::string>(), report.valid + report.replaced + report.invalid,
                100.0 * report.valid_fraction(), report.replaced, report.invalid, report.seconds_total);
@@ -134,10 +138,10 @@ void add_piv3d_command(CLI::App& root) {
   cmd->add_option("--b", args->name_b, "Name of the second volume")->capture_default_str();
   cmd->add_option("-o,--out", args->out, "Results file to write (.h5)")->required();
   cmd->add_flag("--overwrite", args->overwrite, "Replace the results file if it exists");
-  cmd->add_option("--dt-ns", args->dt_ns, "Pulse separation in ns (default: the one recorded in the volume file)");
+  cli::add_dt_option(*cmd, args->dt_ns, "Pulse separation (default: the one recorded in the volume file)");
   add_correlation_flags(*cmd, args->correlation);
   cmd->add_option("--threads", args->threads, "OpenMP threads (0: all cores)")->capture_default_str();
-  cmd->add_flag("--json", args->json, "Print the summary as JSON");
+  add_json_flag(*cmd, args->json);
   cmd->callback([args] { run(*args); });
 }
 

@@ -16,6 +16,8 @@
 #include <fmt/core.h>
 
 #include "commands.h"
+#include "tomorig/core/cli_vocabulary.h"
+#include "tomorig/core/set_selection.h"
 #include "json_summary.h"
 #include "tomorig/pipeline/session_preprocessor.h"
 #include "tomorig/core/console.h"
@@ -49,24 +51,11 @@ struct SetRange {
   std::uint64_t end = 0;  // one past the last
 };
 
-// "A:B" is the half-open range [A, B); "A:" runs to the end; empty means every set.
+// The one set syntax (core/set_selection.h); preprocess writes a run of consecutive sets.
 SetRange parse_sets(const std::string& text, std::uint64_t count) {
-  if (text.empty()) return {0, count};
-  const auto colon = text.find(':');
-  const auto fail = [&](const std::string& why) {
-    throw bad_input(fmt::format("--sets '{}': {}; write A:B for sets A to B-1 (0-based), or A: for A to the end; the "
-                                "session has {} sets", text, why, count));
-  };
-  if (colon == std::string::npos) fail("missing ':'");
-  const auto number = [&](const std::string& part, std::uint64_t fallback) -> std::uint64_t {
-    if (part.empty()) return fallback;
-    if (part.find_first_not_of("0123456789") != std::string::npos || part.size() > 18) fail("'" + part + "' is not a set number");
-    return std::stoull(part);
-  };
-  SetRange range{number(text.substr(0, colon), 0), number(text.substr(colon + 1), count)};
-  if (range.end > count) fail("the end is past the last set");
-  if (range.first >= range.end) fail("the range is empty");
-  return range;
+  const SetSelection selection = text.empty() ? SetSelection() : SetSelection::parse(text);
+  const auto [first, end] = selection.range(count);
+  return {first, end};
 }
 
 // A relative reference path in the chain file is relative to the chain file's folder.
@@ -76,6 +65,7 @@ fs::path resolve(const std::string& file, const fs::path& chain_path) {
 }
 
 void run(const PreprocessArgs& args) {
+  cli::require_session(args.session, "preprocess");
   // Before the sequence passes, which can take minutes: an existing output is refused now.
   storage::check_output_path(args.out, args.overwrite, "session");
   const preprocess::ChainSpec spec = preprocess::read_chain_file(args.chain);
@@ -174,11 +164,11 @@ void add_preprocess_command(CLI::App& root) {
   auto args = std::make_shared<PreprocessArgs>();
   CLI::App* cmd = root.add_subcommand(
       "preprocess", "Apply an image preprocessing chain (TOML) to a session and write a preprocessed session");
-  cmd->add_option("--session", args->session, "Session file to read (.h5)")->required();
+  cli::add_session_argument(*cmd, args->session, "Session file to read (.h5)");
   cmd->add_option("--chain", args->chain, "Preprocessing chain ([[preprocess.steps]] TOML, docs/preprocessing.md)")
       ->required();
   cmd->add_option("-o,--out", args->out, "Preprocessed session to write (.h5)")->required();
-  cmd->add_option("--sets", args->sets, "Sets A:B (A to B-1, 0-based) or A: (to the end); default all");
+  cmd->add_option("--sets", args->sets, "Sets: N (the first N), A:B (A to B-1) or consecutive A-B; default all");
   cmd->add_flag("--overwrite", args->overwrite, "Replace an existing output file");
   add_json_flag(*cmd, args->json);
   cmd->callback([args] { run(*args); });

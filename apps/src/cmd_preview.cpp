@@ -15,6 +15,7 @@
 #include <zmq.hpp>
 
 #include "commands.h"
+#include "tomorig/core/cli_vocabulary.h"
 #include "http_options.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
@@ -149,8 +150,8 @@ void add_preview_command(CLI::App& root) {
                   "With --http: also show the run's status stream (tomorig run --status), e.g. tcp://127.0.0.1:5556");
   cmd->add_option("--config", args->config_path,
                   "With --http: the rig file, for the trigger plan and the quick-look targets on the dashboard");
-  cmd->add_option("--session", args->session,
-                  "With --http: show this session's stored quick-look history instead of a live stream");
+  cli::add_session_argument(*cmd, args->session,
+                            "With --http: show this session's stored quick-look history instead of a live stream");
   cmd->callback([args, cmd] {
     args->http_given = args->http.given(*cmd);
     watch(*args);

@@ -1,7 +1,9 @@
 // tomorig process: the back-end (pipeline::run_backend). For each set of a session: preprocess
 // the frames, reconstruct both exposures, correlate them into a results file that is complete
 // after every set, so an interrupted run resumes where it stopped.
+#include <cmath>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -9,8 +11,12 @@
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
+#include "json_summary.h"
 #include "process_progress.h"
+#include "tomorig/core/cli_vocabulary.h"
+#include "tomorig/core/console.h"
 #include "tomorig/core/error.h"
+#include "tomorig/core/set_selection.h"
 #include "tomorig/pipeline/backend.h"
 #include "tomorig/rig/stop_signal.h"
 
@@ -20,16 +26,23 @@ namespace {
 struct ProcessArgs {
   std::string session;
   std::string out;
-  std::string config;
+  std::string chain;
   std::string png;
-  bool json = false;
+  std::string sets;  // the one set syntax; process takes the first N sets
+  std::optional<double> dt_ns;
+  JsonOutput json;
   pipeline::BackendOptions backend;
 };
 
 void run(const ProcessArgs& args) {
+  cli::require_session(args.session, "process");
   pipeline::BackendOptions options = args.backend;
   options.out = args.out;
-  options.preprocess_chain = args.config;
+  options.preprocess_chain = args.chain;
+  if (!args.sets.empty())
+    options.max_sets = SetSelection::parse(args.sets).leading_count(
+        "a results file holds the sets of a session from set 0 on, in order (resume continues there)");
+  if (args.dt_ns) options.dt_ns = static_cast<std::int64_t>(std::llround(*args.dt_ns));
   options.png = args.png;
   const rig::StopSignalGuard stop_signal;
   std::unique_ptr<ProgressLine> progress;
@@ -42,6 +55,15 @@ void run(const ProcessArgs& args) {
     else spdlog::info("{}", text);
   };
   hooks.started = [&](std::uint64_t sets_to_do) { progress = std::make_unique<ProgressLine>(sets_to_do); };
+  hooks.step = [&](const pipeline::BackendStep& step) {
+    if (!progress) return;
+    const std::string text = step.text();
+    if (step.iteration == 0 && verbosity() == Verbosity::verbose) {
+      progress->break_line();
+      spdlog::debug("{}", text);
+    }
+    progress->step(text, step.kind != pipeline::BackendStep::Kind::correlating);
+  };
   hooks.set_done = [&](const pipeline::BackendSetDone& s) {
     const std::string by =
         s.rank < 0 ? std::string()
@@ -64,10 +86,10 @@ void run(const ProcessArgs& args) {
     throw runtime_error(fmt::format("interrupted by {}: '{}' is valid and holds {} of {} sets; run the same command "
                                     "again to resume",
                                     stop_signal.signal_name(), args.out, report.sets_in_file, report.sets_asked));
-  if (args.json)
-    fmt::print("{}\n", report.to_json().dump(2));
-  else
-    fmt::print("{}\n", report.brief());
+  if (!args.json.to_stdout()) fmt::print("{}\n", report.brief());
+  nlohmann::json summary = json_summary("process");
+  summary.update(report.to_json());
+  emit_json(args.json, summary);
 }
 
 }  // namespace
@@ -78,12 +100,13 @@ void add_process_command(CLI::App& root) {
   pipeline::ReconstructionChoices& r = b.reconstruction;
   CLI::App* cmd = root.add_subcommand(
       "process", "Back-end: preprocess, reconstruct and correlate every set of a session into a results file");
-  cmd->add_option("--session", args->session, "Session file (.h5)")->required();
+  cli::add_session_argument(*cmd, args->session, "Session file (.h5)");
   cmd->add_option("--calib", b.calib,
                   "Calibration file (TOML), or 'truth' for a simulated session's exact cameras (default: the truth "
                   "if present, else the rig config's calibration file)");
-  cmd->add_option("--config", args->config,
+  cmd->add_option("--chain", args->chain,
                   "Preprocessing chain ([[preprocess.steps]] TOML, as for 'tomorig preprocess --chain'); default: none");
+  cli::add_deprecated_option(*cmd, "--config", args->chain, "--chain (--config names the rig file elsewhere)");
   cmd->add_option("-o,--out", args->out, "Results file (.h5); an existing one of the same session and parameters is "
                                          "resumed")
       ->required();
@@ -91,13 +114,21 @@ void add_process_command(CLI::App& root) {
   cmd->add_option("--smooth", b.smooth, "Gaussian smoothing sigma x,y,z (voxel) of each reconstructed volume")
       ->delimiter(',')
       ->expected(3);
-  cmd->add_option("--dt-ns", b.dt_ns, "Pulse separation in ns, for sessions that did not record it");
-  cmd->add_option("--max-sets", b.max_sets, "Process only the first N sets (0: all)");
+  cli::add_dt_option(*cmd, args->dt_ns, "Pulse separation, for sessions that did not record it");
+  cmd->add_option("--sets", args->sets, "Sets to process: N (the first N) or 0:N; default all");
+  cmd->add_option_function<std::uint64_t>(
+         "--max-sets",
+         [args](std::uint64_t n) {
+           cli::warn_deprecated("--max-sets", "--sets N");
+           if (n > 0) args->sets = std::to_string(n);
+         },
+         "deprecated: use --sets N")
+      ->group("");
   pipeline::add_correlation_flags(*cmd, b.correlation);
   cmd->add_option("--threads", b.threads, "OpenMP threads per stage (0: all cores)")->capture_default_str();
   cmd->add_flag("--sequential", b.sequential, "Do not overlap reconstruction and correlation of different sets");
   cmd->add_flag("--overwrite", b.overwrite, "Start a new results file even if one exists");
-  cmd->add_flag("--json", args->json, "Print the summary as JSON");
+  add_json_flag(*cmd, args->json);
   cmd->add_option("--png", args->png,
                   "Also write a picture (PNG) of the mean field's middle z-slice: grey = in-plane magnitude, line = "
                   "direction, black = no valid vector");

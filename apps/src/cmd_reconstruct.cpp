@@ -11,11 +11,16 @@
 
 #include "commands.h"
 #include "tomorig/pipeline/report_json.h"
+#include "json_summary.h"
+#include "tomorig/core/cli_vocabulary.h"
 #include "tomorig/pipeline/session_geometry.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
+#include "tomorig/processing/quality/depth_profile_plot.h"
 #include "tomorig/processing/reconstruction/reconstructor.h"
 #include "tomorig/processing/reconstruction/smoothing.h"
+#include "tomorig/storage/image_file.h"
+#include "tomorig/storage/output_path.h"
 #include "tomorig/storage/session_file.h"
 #include "tomorig/storage/volume_file.h"
 
@@ -40,7 +45,8 @@ struct ReconstructArgs {
   pipeline::ReconstructionChoices recon{.algorithm_from_rig = true};
   std::string out;
   bool overwrite = false;
-  bool json = false;
+  JsonOutput json;
+  std::string png;  // intensity-versus-depth plot
   bool sparse_only = false;
   std::vector<double> smooth;  // sigma x, y, z in voxels; empty: none
 };
@@ -66,6 +72,8 @@ std::vector<Image> exposure_images(const FrameSet& set, Exposure e, const std::s
 }
 
 void run(const ReconstructArgs& args) {
+  cli::require_session(args.session, "reconstruct");
+  if (!args.png.empty()) storage::check_output_path(args.png, args.overwrite, "plot");  // before any work
   const storage::SessionReader session(args.session);
   if (args.set >= session.set_count())
     throw bad_input(fmt::format("--set {} is out of range: session '{}' has {} sets (0 to {})", args.set,
@@ -91,6 +99,7 @@ void run(const ReconstructArgs& args) {
   storage::VolumeFileWriter out(args.out, {args.session, args.set, parameters.dump()},
                                 {.overwrite = args.overwrite, .dense_export = !args.sparse_only});
   nlohmann::json reports = nlohmann::json::object();
+  std::vector<quality::DepthCurve> depth_curves;
   for (const Exposure e : exposures_of(args.exposure)) {
     const std::string name = e == Exposure::A ? "a" : "b";
     input.images = exposure_images(set, e, args.session, args.set);
@@ -104,16 +113,24 @@ void run(const ReconstructArgs& args) {
     const nlohmann::json report_json = to_json(report);
     out.add(name, volume, {options.algorithm, e == Exposure::A ? "A" : "B", report_json.dump()});
     reports[name] = report_json;
+    if (!args.png.empty()) {
+      quality::DepthCurve curve{e == Exposure::A ? "exposure A" : "exposure B", {}, quality::mean_intensity_per_slice(volume)};
+      for (int k = 0; k < volume.grid.nz; ++k) curve.z_mm.push_back(volume.grid.centre_of(0, 0, k).z);
+      depth_curves.push_back(std::move(curve));
+    }
   }
   out.finish();
-  if (args.json) {
-    fmt::print("{}\n", nlohmann::json{{"out", args.out},
-                                      {"xdmf", storage::VolumeFileWriter::sidecar_path(args.out).string()},
-                                      {"session", args.session},
-                                      {"set", args.set},
-                                      {"volumes", reports}}
-                           .dump(2));
-  } else {
+  if (!args.png.empty())
+    storage::write_png(args.png, quality::depth_profile_plot(
+                                     depth_curves, fmt::format("set {}, {}", args.set, options.algorithm)));
+  nlohmann::json summary = json_summary("reconstruct");
+  summary.update(nlohmann::json{{"out", args.out},
+                                {"xdmf", storage::VolumeFileWriter::sidecar_path(args.out).string()},
+                                {"session", args.session},
+                                {"set", args.set},
+                                {"volumes", reports}});
+  emit_json(args.json, summary);
+  if (!args.json.to_stdout()) {
     fmt::print("wrote {} and {} ({} volume{})\n", args.out, storage::VolumeFileWriter::sidecar_path(args.out).string(),
                reports.size(), reports.size() == 1 ? "" : "s");
   }
@@ -124,7 +141,7 @@ void run(const ReconstructArgs& args) {
 void add_reconstruct_command(CLI::App& root) {
   auto args = std::make_shared<ReconstructArgs>();
   CLI::App* cmd = root.add_subcommand("reconstruct", "Reconstruct the particle volume of one set of a session");
-  cmd->add_option("--session", args->session, "Session file (.h5)")->required();
+  cli::add_session_argument(*cmd, args->session, "Session file (.h5)");
   cmd->add_option("--calib", args->calib,
                   "Calibration file (TOML, from tomorig calibrate), or 'truth' for a simulated session's exact cameras "
                   "(default: the truth if present, else the rig config's calibration file)");
@@ -141,8 +158,11 @@ void add_reconstruct_command(CLI::App& root) {
       ->delimiter(',')
       ->expected(3);
   cmd->add_flag("--overwrite", args->overwrite, "Replace existing output files");
+  cmd->add_option("--png", args->png,
+                  "Also write intensity against depth (mean per voxel of each z-slice, one curve per exposure) as a "
+                  "PNG plot");
   cmd->add_flag("--sparse-only", args->sparse_only, "Store only the sparse voxel list (no dense export for ParaView)");
-  cmd->add_flag("--json", args->json, "Print the reconstruction reports as one JSON object");
+  add_json_flag(*cmd, args->json);
   cmd->callback([args] { run(*args); });
 }
 

@@ -81,7 +81,10 @@ void add_record_command(CLI::App& root) {
   cmd->add_option("--sets", args->options.sets, "Stop after this many sets (default: at the sender's end of acquisition, Ctrl-C or --idle-timeout)");
   cmd->add_option("--compression", args->options.compression, "Frame compression: none | bitshuffle-lz4")
       ->capture_default_str();
-  cmd->add_option("--idle-timeout", args->options.idle_timeout_s, "Stop when no set arrived for this many seconds");
+  cmd->add_option("--idle-timeout", args->options.idle_timeout_s,
+                  "Stop when no set arrived for this many seconds (counted from the start until the first set); 0: "
+                  "wait for ever")
+      ->capture_default_str();
   cmd->add_flag("--overwrite", args->options.recorder.overwrite, "Replace an existing output file");
   cmd->add_option("--disk-reserve-mb", args->options.recorder.disk_reserve_mb,
                   "Stop recording cleanly when the disk would have less than this many MB free")

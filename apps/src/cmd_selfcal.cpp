@@ -15,6 +15,10 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "json_summary.h"
+#include "tomorig/core/cli_vocabulary.h"
+#include "tomorig/core/set_selection.h"
+#include "tomorig/storage/session_file.h"
 #include "tomorig/core/error.h"
 #include "tomorig/pipeline/session_selfcal.h"
 
@@ -33,7 +37,7 @@ struct SelfcalArgs {
   std::vector<double> perturb;  // camera, du, dv, rotation deg
   std::string gauge = "sparse";
   bool overwrite = false;
-  bool json = false;
+  JsonOutput json;
   pipeline::SessionSelfcalOptions options;  // calib, grid and the algorithm's settings bound directly
 };
 
@@ -51,30 +55,12 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& fl
   return values;
 }
 
-// "0,2,5-7" -> {0, 2, 5, 6, 7}; empty: none named (the library takes the first ten).
-std::vector<std::uint64_t> parse_sets(const std::string& text) {
-  std::vector<std::uint64_t> sets;
-  if (!text.empty()) {
-    std::stringstream in(text);
-    std::string item;
-    const auto fail = [&] {
-      throw bad_input(fmt::format("--sets '{}' is not valid: expected set indices and ranges such as 0,2,5-7", text));
-    };
-    const auto number = [&](const std::string& s) {
-      std::uint64_t v = 0;
-      const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-      if (s.empty() || ec != std::errc() || end != s.data() + s.size()) fail();
-      return v;
-    };
-    while (std::getline(in, item, ',')) {
-      const auto dash = item.find('-');
-      const std::uint64_t first = number(item.substr(0, dash));
-      const std::uint64_t last = dash == std::string::npos ? first : number(item.substr(dash + 1));
-      if (last < first) fail();
-      for (std::uint64_t k = first; k <= last; ++k) sets.push_back(k);
-    }
-  }
-  return sets;
+// The one set syntax (core/set_selection.h) against the session's sets; empty: none named (the
+// library takes the first ten).
+std::vector<std::uint64_t> parse_sets(const std::string& text, const std::string& session) {
+  if (text.empty()) return {};
+  const SetSelection selection = SetSelection::parse(text);
+  return selection.indices(storage::SessionReader(session).set_count());
 }
 
 nlohmann::json figures_json(const calibration::DisparityFigures& f) {
@@ -122,7 +108,7 @@ pipeline::SessionSelfcalOptions options_of(const SelfcalArgs& args) {
   o.selfcal.subvolumes_y = args.subvolumes[1];
   o.selfcal.subvolumes_z = args.subvolumes[2];
   o.selfcal.sparse_gauge = args.gauge == "sparse";
-  o.sets = parse_sets(args.sets);
+  o.sets = parse_sets(args.sets, args.session);
   o.use_a = args.exposure != "b";
   o.use_b = args.exposure != "a";
   if (!args.volume.empty()) {
@@ -178,6 +164,7 @@ nlohmann::json report_json(const SelfcalArgs& args, const pipeline::SessionSelfc
 }
 
 void run(const SelfcalArgs& args) {
+  cli::require_session(args.session, "selfcal");
   if (std::filesystem::exists(args.out) && !args.overwrite)
     throw bad_input(fmt::format("'{}' exists; give --overwrite to replace it", args.out));
   const pipeline::SessionSelfcalReport s = pipeline::selfcal_session(
@@ -197,9 +184,10 @@ void run(const SelfcalArgs& args) {
     }
   // Not converged: report, then fail without writing a calibration that is not good enough.
   if (r.converged) calibration::save_calibration(args.out, s.calibration);
-  if (args.json) {
-    fmt::print("{}\n", report_json(args, s).dump(2));
-  } else {
+  nlohmann::json summary = json_summary("selfcal");
+  summary.update(report_json(args, s));
+  emit_json(args.json, summary);
+  if (!args.json.to_stdout()) {
     const calibration::VolumeBounds& b = s.bounds;
     fmt::print("self-calibration of {} ({}), {} snapshot(s), volume x [{:.3f}, {:.3f}] y [{:.3f}, {:.3f}] z [{:.3f}, "
                "{:.3f}] mm, {} x {} x {} sub-volumes\n",
@@ -223,12 +211,12 @@ void add_selfcal_command(CLI::App& root) {
   auto args = std::make_shared<SelfcalArgs>();
   CLI::App* cmd = root.add_subcommand(
       "selfcal", "Volume self-calibration: correct a calibration with the particle images of a session");
-  cmd->add_option("--session", args->session, "Session file (.h5) with particle images")->required();
+  cli::add_session_argument(*cmd, args->session, "Session file (.h5) with particle images");
   cmd->add_option("--calib", args->options.calib,
                   "Calibration file (TOML) to correct, or 'truth' for a simulated session's exact cameras "
                   "(default: the truth if present, else the rig config's calibration file)");
   cmd->add_option("-o,--out", args->out, "Corrected calibration file to write (TOML)")->required();
-  cmd->add_option("--sets", args->sets, fmt::format("Sets to use, e.g. 0,2,5-7 (default: the first {})", args->options.default_sets));
+  cmd->add_option("--sets", args->sets, fmt::format("Sets to use: N (the first N), A:B (A to B-1) or a list such as 0,2,5-7 (default: the first {})", args->options.default_sets));
   cmd->add_option("--exposure", args->exposure, "Exposures to use: a, b or both")
       ->check(CLI::IsMember({"a", "b", "both"}))
       ->capture_default_str();
@@ -259,7 +247,7 @@ void add_selfcal_command(CLI::App& root) {
       ->delimiter(',')
       ->expected(4);
   cmd->add_flag("--overwrite", args->overwrite, "Replace an existing output file");
-  cmd->add_flag("--json", args->json, "Print the report as one JSON object");
+  add_json_flag(*cmd, args->json);
   cmd->callback([args] { run(*args); });
 }
 

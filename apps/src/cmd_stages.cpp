@@ -10,6 +10,9 @@
 #include <fmt/core.h>
 
 #include "commands.h"
+#include "json_summary.h"
+#include "tomorig/core/cli_vocabulary.h"
+#include "tomorig/core/set_selection.h"
 #include "tomorig/core/error.h"
 #include "tomorig/pipeline/stage_registry.h"
 #include "tomorig/rig/replay_schedule.h"
@@ -23,8 +26,8 @@ namespace {
 struct StagesArgs {
   std::string session;
   std::vector<std::string> stages;
-  std::string sets;  // A:B
-  bool json = false;
+  std::string sets;  // the one set syntax; stages feeds a run of consecutive sets
+  JsonOutput json;
 };
 
 void run(const StagesArgs& args) {
@@ -39,17 +42,18 @@ void run(const StagesArgs& args) {
   pipeline::StageChain chain = pipeline::make_chain(registry, specs);  // bad settings fail here
 
   const storage::SessionReader session(args.session);
-  const rig::SetRange range = args.sets.empty() ? rig::SetRange{0, session.set_count()}
-                                                : rig::parse_set_range(args.sets, session.set_count());
+  const auto [first, end] =
+      (args.sets.empty() ? SetSelection() : SetSelection::parse(args.sets)).range(session.set_count());
+  const rig::SetRange range{first, end};
   const rig::StopSignalGuard stop;
   chain.begin(pipeline::describe_session(session));
   for (std::uint64_t s = range.first; s < range.last && !stop.stop_requested(); ++s) chain.push(session.read_set(s));
   const std::vector<pipeline::StageReport> reports = chain.end();
-  if (args.json) {
-    nlohmann::json out = nlohmann::json::array();
-    for (const auto& r : reports) out.push_back(r.to_json());
-    fmt::print("{}\n", out.dump(2));
-  } else {
+  nlohmann::json summary = json_summary("stages");
+  summary["stages"] = nlohmann::json::array();
+  for (const auto& r : reports) summary["stages"].push_back(r.to_json());
+  emit_json(args.json, summary);
+  if (!args.json.to_stdout()) {
     for (const auto& r : reports) fmt::print("{}\n", r.brief());
   }
   if (stop.stop_requested()) throw runtime_error(fmt::format("stopped by {}", stop.signal_name()));
@@ -61,10 +65,10 @@ void add_stages_command(CLI::App& root) {
   auto args = std::make_shared<StagesArgs>();
   CLI::App* cmd = root.add_subcommand(
       "stages", "List the pipeline stages, or run a chain of them over a recorded session (as a live rig would)");
-  cmd->add_option("--session", args->session, "Session file (.h5) to feed through the stages; none: list the stages");
+  cli::add_session_argument(*cmd, args->session, "Session file (.h5) to feed through the stages; none: list the stages");
   cmd->add_option("--stage", args->stages, "TYPE or TYPE:key=value,key=value (repeatable; docs/architecture.md)");
-  cmd->add_option("--sets", args->sets, "Sets A:B of the session (default: all)");
-  cmd->add_flag("--json", args->json, "Print the stage reports as JSON");
+  cmd->add_option("--sets", args->sets, "Sets: N (the first N), A:B (A to B-1) or consecutive A-B (default: all)");
+  add_json_flag(*cmd, args->json);
   cmd->callback([args] { run(*args); });
 }
 

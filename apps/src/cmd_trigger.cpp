@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "json_summary.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/trigger/plan_diagram.h"
 #include "tomorig/trigger/rig_trigger.h"
@@ -17,7 +18,7 @@ namespace {
 
 struct PlanOptions {
   std::string config_path;
-  bool json = false;
+  JsonOutput json;
 };
 
 double us(std::int64_t ns) { return static_cast<double>(ns) / 1000.0; }
@@ -84,9 +85,11 @@ void print_plan(const PlanOptions& opt) {
   // Throws bad_input (exit 2) naming what is infeasible, unsafe or beyond the device.
   const trigger::TimingPlan plan = trigger::plan_and_check(setup);
   const trigger::DeviceCapabilities device = setup.capabilities();
-  if (opt.json) {
-    fmt::print("{}\n", plan_json(rig.name, plan, device).dump(2));
-    return;
+  if (opt.json.wanted()) {
+    nlohmann::json j = json_summary("trigger plan");
+    j.update(plan_json(rig.name, plan, device));
+    emit_json(opt.json, j);
+    if (opt.json.to_stdout()) return;
   }
   fmt::print("rig: {}\n{}", rig.name, trigger::timing_diagram(plan, device));
   fmt::print("feasible: within the light-source safety limits and the {} device's capabilities\n", device.device);
@@ -103,7 +106,7 @@ void add_trigger_command(CLI::App& root) {
       "Print the frame-straddling timing plan (one row per channel, edge times in us) and check it against the "
       "light-source safety limits and the trigger device; exit code 2 when infeasible");
   plan->add_option("--config", opt->config_path, "Rig configuration (TOML); default: the embedded simulated rig");
-  plan->add_flag("--json", opt->json, "Print the plan as one JSON object");
+  add_json_flag(*plan, opt->json);
   plan->callback([opt] { print_plan(*opt); });
 }
 

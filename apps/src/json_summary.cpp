@@ -11,16 +11,17 @@ namespace tomorig::app {
 
 void add_json_flag(CLI::App& cmd, JsonOutput& out) {
   out.flag = cmd.add_option("--json", out.file,
-                            "Print the summary as one JSON object on stdout, or with a FILE write it there "
-                            "(--json=FILE)")
-                 ->expected(0, 1);
+                            "Print the summary as one JSON object on stdout (and nothing else there), or write "
+                            "it to FILE (.json, or --json=FILE)")
+                 ->expected(0, 1)
+                 ->type_name("[FILE]");
 }
 
 nlohmann::json json_summary(const std::string& command) { return {{json_key::kCommand, command}}; }
 
 void emit_json(const JsonOutput& out, const nlohmann::json& summary) {
   if (!out.wanted()) return;
-  if (out.file.empty()) {
+  if (out.to_stdout()) {
     fmt::print("{}\n", summary.dump(2));
     return;
   }

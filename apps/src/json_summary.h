@@ -1,7 +1,9 @@
 #pragma once
 // `--json [FILE]`, the same for every summarising command: the summary as one JSON object on
 // stdout (`--json`, and nothing else on stdout), or written to FILE (`--json=FILE` or
-// `--json FILE`) with the usual text on stdout. The keys every summary shares are named here,
+// `--json FILE.json`; `--json -` is stdout) with the usual text on stdout. The word after --json
+// is its FILE only if it ends in .json (core/cli_vocabulary.h, apply_json_value_rule), so
+// `tomorig inspect --json s.h5` still reads s.h5. The keys every summary shares are named here,
 // once (docs/cli.md, "Output conventions").
 #include <string>
 
@@ -22,7 +24,7 @@ struct JsonOutput {
   CLI::Option* flag = nullptr;
   std::string file;  // empty: stdout
   bool wanted() const { return flag != nullptr && flag->count() > 0; }
-  bool to_stdout() const { return wanted() && file.empty(); }
+  bool to_stdout() const { return wanted() && (file.empty() || file == "-"); }
 };
 
 void add_json_flag(CLI::App& cmd, JsonOutput& out);

@@ -1,7 +1,10 @@
 // tomorig: the command line. Parses flags, calls the libraries, prints, and maps errors to
 // exit codes here and nowhere else.
+#include <algorithm>
 #include <cstdio>
 #include <exception>
+#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
@@ -10,12 +13,14 @@
 #include "console_flags.h"
 #include "exit_codes.h"
 #include "tomorig/bench/bench_command.h"
+#include "tomorig/core/cli_vocabulary.h"
 #include "tomorig/core/error.h"
 #include "tomorig/core/version.h"
 
 int main(int argc, char** argv) {
   using namespace tomorig::app;
   CLI::App app{"tomorig: tomographic PIV and shadowgraphy acquisition and processing"};
+  app.name("tomorig");  // parsed from a vector below, so argv[0] does not name it
   app.set_version_flag("--version", std::string(tomorig::software_version()));
   app.require_subcommand(1);
   app.footer("Exit codes: 0 ok, 1 runtime failure, 2 bad usage or bad input.\n"
@@ -42,7 +47,10 @@ int main(int argc, char** argv) {
   add_console_flags(app);  // after every command: each gets --quiet and --verbose
 
   try {
-    app.parse(argc, argv);
+    std::vector<std::string> args(argv + 1, argv + argc);
+    args = tomorig::cli::apply_json_value_rule(std::move(args));
+    std::reverse(args.begin(), args.end());  // CLI11 takes a vector last-first
+    app.parse(std::move(args));
     return kExitOk;
   } catch (const CLI::Success& e) {  // --help, --version
     app.exit(e);

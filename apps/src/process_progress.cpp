@@ -30,12 +30,24 @@ std::string ProgressLine::text() const {
   const int filled = total_ == 0 ? width : static_cast<int>(width * done_ / total_);
   const double rate = sets_per_second();
   const std::string eta = rate > 0 ? format_duration(static_cast<double>(total_ - done_) / rate) : "?";
-  return fmt::format("[{}{}] {}/{} sets  {:.3g} sets/s  ETA {}", std::string(filled, '#'),
-                     std::string(width - filled, '-'), done_, total_, rate, eta);
+  std::string text = fmt::format("[{}{}] {}/{} sets  {:.3g} sets/s  ETA {}", std::string(filled, '#'),
+                                 std::string(width - filled, '-'), done_, total_, rate, eta);
+  for (const std::string* step : {&correlation_step_, &reconstruction_step_})
+    if (!step->empty()) text += "  | " + *step;
+  return text;
+}
+
+void ProgressLine::step(const std::string& text, bool reconstruction) {
+  const std::lock_guard lock(mutex_);
+  (reconstruction ? reconstruction_step_ : correlation_step_) = text;
+  if (line_.due()) line_.update(this->text());
 }
 
 void ProgressLine::set_done() {
+  const std::lock_guard lock(mutex_);
   ++done_;
+  correlation_step_.clear();
+  if (done_ >= total_) reconstruction_step_.clear();
   if (done_ >= total_) line_.finish(text());
   else if (line_.due()) line_.update(text());
 }

@@ -56,7 +56,7 @@ std::vector<std::int64_t> pulse_separations(const storage::SessionReader& sessio
     dt[s] = options.dt_ns > 0 ? options.dt_ns : session.set_record(s).dt_ns;
     if (dt[s] <= 0)
       throw bad_input(fmt::format("set {} of session '{}' has pulse separation dt = {} ns (missing), so its velocity "
-                                  "cannot be computed; give the laser pulse separation with --dt-ns",
+                                  "cannot be computed; give the laser pulse separation with --dt (e.g. --dt 80us)",
                                   s, path.string(), dt[s]));
   }
   return dt;
@@ -98,9 +98,22 @@ void draw_mean_slice(const storage::EnsembleStatistics& stats, const fs::path& p
 
 void BackendOptions::validate() const {
   if (out.empty()) throw bad_input("the back-end has no results file: give one with -o/--out");
-  if (dt_ns < 0) throw bad_input(fmt::format("--dt-ns {} must be > 0", dt_ns));
+  if (dt_ns < 0) throw bad_input(fmt::format("--dt {}ns must be > 0", dt_ns));
   if (!smooth.empty() && smooth.size() != 3)
     throw bad_input(fmt::format("--smooth takes 3 sigmas x,y,z (voxel), not {}", smooth.size()));
+}
+
+std::string BackendStep::text() const {
+  switch (kind) {
+    case Kind::preprocessing:
+      return fmt::format("set {}: reading and preprocessing", set);
+    case Kind::reconstructing:
+      return iterations > 0 ? fmt::format("set {}: reconstructing {}, iteration {}/{}", set, exposure, iteration, iterations)
+                            : fmt::format("set {}: reconstructing {}", set, exposure);
+    case Kind::correlating:
+      return fmt::format("set {}: correlating", set);
+  }
+  return {};
 }
 
 nlohmann::json BackendReport::to_json() const {
@@ -164,12 +177,24 @@ void BackendInputs::prepare_preprocessing() {
   if (!preprocessor_) preprocessor_.emplace(session, options.preprocess_chain);
 }
 
-ReconstructedSet BackendInputs::reconstruct(std::uint64_t index) {
+ReconstructedSet BackendInputs::reconstruct(std::uint64_t index, const std::function<void(const BackendStep&)>& step) {
   prepare_preprocessing();
   const auto set_started = Clock::now();
+  if (step) step({.set = index, .kind = BackendStep::Kind::preprocessing});
   FrameSet set = session.read_set(index);
   preprocessor_->apply(set);
-  ReconstructedSet pair = processor.reconstruct(set, index, dt[index]);
+  std::function<void(char)> exposure_started;
+  if (step)
+    exposure_started = [&](char e) {
+      step({.set = index, .kind = BackendStep::Kind::reconstructing, .exposure = e});
+      processor.set_iteration_progress([&step, index, e](int done, int at_most) {
+        if (done > 0)
+          step({.set = index, .kind = BackendStep::Kind::reconstructing, .exposure = e, .iteration = done,
+                .iterations = at_most});
+      });
+    };
+  ReconstructedSet pair = processor.reconstruct(set, index, dt[index], exposure_started);
+  if (step) processor.set_iteration_progress({});
   pair.started = set_started;  // a set's time includes reading and preprocessing it
   return pair;
 }
@@ -252,12 +277,13 @@ BackendReport run_backend(const fs::path& session_path, const BackendOptions& op
   std::size_t next = 0;
   const auto produce = [&](const std::function<bool()>& stop) -> std::optional<ReconstructedSet> {
     if (next >= todo.size() || stop() || stop_requested()) return std::nullopt;
-    return inputs.reconstruct(todo[next++]);
+    return inputs.reconstruct(todo[next++], hooks.step);
   };
 
   double valid_sum = 0.0;
   const auto consume = [&](ReconstructedSet& r) -> bool {
     if (stop_requested()) return false;
+    if (hooks.step) hooks.step({.set = r.index, .kind = BackendStep::Kind::correlating});
     piv::CorrelationReport corr_report;
     const storage::SetResult result = inputs.processor.correlate(r, corr_report);
     results.add(result);

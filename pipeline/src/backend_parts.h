@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -26,7 +27,8 @@ class BackendInputs {
   // made after the quick checks (the results file's) have passed.
   void prepare_preprocessing();
   // Reads set `index`, preprocesses it and reconstructs both exposures; its time starts here.
-  ReconstructedSet reconstruct(std::uint64_t index);
+  // `step` (may be empty) is told of preprocessing and of each exposure's reconstruction.
+  ReconstructedSet reconstruct(std::uint64_t index, const std::function<void(const BackendStep&)>& step = {});
 
   const std::filesystem::path path;
   const BackendOptions options;

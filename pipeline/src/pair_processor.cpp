@@ -52,7 +52,18 @@ PairProcessor::PairProcessor(const SessionDescription& recording, const BackendO
       reconstructor_(recon::make_reconstructor(setup_.options)),
       correlation_(correlation_for(options, setup_.input.grid)) {}
 
-ReconstructedSet PairProcessor::reconstruct(const FrameSet& set, std::uint64_t index, std::int64_t dt_ns) const {
+void PairProcessor::set_iteration_progress(std::function<void(int, int)> progress) const {
+  if (!progress) {
+    reconstructor_->set_iteration_observer({});
+    return;
+  }
+  const int at_most = setup_.options.max_iterations;
+  reconstructor_->set_iteration_observer(
+      [progress = std::move(progress), at_most](const recon::IterationView& v) { progress(v.iteration, at_most); });
+}
+
+ReconstructedSet PairProcessor::reconstruct(const FrameSet& set, std::uint64_t index, std::int64_t dt_ns,
+                                            const std::function<void(char)>& exposure_started) const {
   ReconstructedSet r;
   r.index = index;
   r.dt_ns = dt_ns;
@@ -68,6 +79,7 @@ ReconstructedSet PairProcessor::reconstruct(const FrameSet& set, std::uint64_t i
                                     name_, index, e == Exposure::A ? "A" : "B", c.camera_id));
       in.images.push_back(f.image);
     }
+    if (exposure_started) exposure_started(e == Exposure::A ? 'A' : 'B');
     recon::ReconstructionReport report;
     SparseVolume v = reconstructor_->reconstruct(in, report);
     if (!options_.smooth.empty())

@@ -3,6 +3,7 @@
 // overlapped) and the backend stage (sets as they come): reconstruct both exposures, then
 // correlate them into a result for the results file.
 #include <chrono>
+#include <functional>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -36,7 +37,12 @@ class PairProcessor {
   PairProcessor(const SessionDescription& recording, const BackendOptions& options);
 
   // `set` already preprocessed. bad_input naming the set and camera if a frame is missing.
-  ReconstructedSet reconstruct(const FrameSet& set, std::uint64_t index, std::int64_t dt_ns) const;
+  // `exposure_started` ('A', 'B') is told before each exposure's reconstruction.
+  ReconstructedSet reconstruct(const FrameSet& set, std::uint64_t index, std::int64_t dt_ns,
+                               const std::function<void(char)>& exposure_started = {}) const;
+  // Told after every SMART/FMART iteration (iterations done, iterations at most); one
+  // reconstruction at a time.
+  void set_iteration_progress(std::function<void(int done, int at_most)> progress) const;
   // Correlates the pair into a result (field, reports, timing) for ResultsWriter::add.
   storage::SetResult correlate(const ReconstructedSet& pair, piv::CorrelationReport& report) const;
 

@@ -7,19 +7,9 @@
 #include <fmt/core.h>
 
 #include "tomorig/core/error.h"
+#include "tomorig/core/set_selection.h"
 
 namespace tomorig::rig {
-namespace {
-
-std::optional<std::uint64_t> parse_index(const std::string& text) {
-  std::uint64_t value = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec != std::errc{} || end != text.data() + text.size() || text.empty()) return std::nullopt;
-  return value;
-}
-
-}  // namespace
-
 ReplayRate parse_replay_rate(const std::string& text) {
   if (text == "recorded") return {ReplayRate::Mode::recorded, 0.0};
   if (text == "max") return {ReplayRate::Mode::max, 0.0};
@@ -31,23 +21,8 @@ ReplayRate parse_replay_rate(const std::string& text) {
 }
 
 SetRange parse_set_range(const std::string& text, std::uint64_t set_count) {
-  const auto colon = text.find(':');
-  std::optional<std::uint64_t> first, last;
-  if (colon == std::string::npos) {
-    first = parse_index(text);
-    if (first) last = *first + 1;
-  } else {
-    const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
-    first = a.empty() ? std::optional<std::uint64_t>(0) : parse_index(a);
-    last = b.empty() ? std::optional<std::uint64_t>(set_count) : parse_index(b);
-  }
-  if (!first || !last)
-    throw bad_input(fmt::format("--sets '{}' is invalid: use A:B (sets A to B-1), A:, :B or A, with set indices "
-                                "from 0", text));
-  if (*first >= *last || *last > set_count)
-    throw bad_input(fmt::format("--sets '{}' selects no sets of this session: it holds sets 0 to {} "
-                                "(A:B sends sets A to B-1)", text, set_count == 0 ? 0 : set_count - 1));
-  return {*first, *last};
+  const auto [first, end] = SetSelection::parse(text).range(set_count);  // the one set syntax
+  return {first, end};
 }
 
 ReplaySchedule make_replay_schedule(const ReplayRate& rate, const std::vector<std::int64_t>& trigger_ns) {

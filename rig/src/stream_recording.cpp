@@ -85,8 +85,9 @@ std::string StreamRecordingReport::failure() const {
 StreamRecording::StreamRecording(StreamRecordingOptions options) : options_(std::move(options)) {
   if (options_.sets && *options_.sets < 1)
     throw bad_input("--sets 0 is invalid: record at least one set (or omit --sets)");
-  if (options_.idle_timeout_s && !(*options_.idle_timeout_s > 0.0))
-    throw bad_input(fmt::format("--idle-timeout {:g} is invalid: it must be > 0 seconds", *options_.idle_timeout_s));
+  if (!(options_.idle_timeout_s >= 0.0))
+    throw bad_input(fmt::format("--idle-timeout {:g} is invalid: give seconds >= 0 (0: wait for ever)",
+                                options_.idle_timeout_s));
   options_.recorder.compression = parse_compression_option(options_.compression);
   prepare_output(options_.recorder);
 }
@@ -157,9 +158,9 @@ StreamRecordingReport StreamRecording::run(const StreamRecordingHooks& hooks) {
       continue;
     }
     if (!message) {
-      if (options_.idle_timeout_s &&
-          duration<double>(Clock::now() - last_arrival).count() >= *options_.idle_timeout_s) {
-        out.stopped_by = fmt::format("no set for {:g} s (--idle-timeout)", *options_.idle_timeout_s);
+      if (options_.idle_timeout_s > 0 &&
+          duration<double>(Clock::now() - last_arrival).count() >= options_.idle_timeout_s) {
+        out.stopped_by = fmt::format("no set for {:g} s (--idle-timeout)", options_.idle_timeout_s);
         break;
       }
       update(false);

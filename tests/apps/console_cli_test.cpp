@@ -32,7 +32,7 @@ class ConsoleCli : public ::testing::Test {
     if (!tomorig_built()) GTEST_SKIP() << "tomorig binary not built";
   }
   static std::string process(const std::string& out, const std::string& extra = "") {
-    return "process --session " + shell_quoted(session_) + " --calib truth --grid 32,32,48,0.0195 --window 16,16,16 "
+    return "process " + shell_quoted(session_) + " --calib truth --grid 32,32,48,0.0195 --window 16,16,16 "
            "--overlap 0.5 --deformation-passes 1 -o " + shell_quoted((*dir_ / out).string()) + " " + extra;
   }
   static std::unique_ptr<TempDir> dir_;
@@ -84,9 +84,9 @@ TEST_F(ConsoleCli, EveryCommandTakesQuietAndVerbose) {
 // Issue 23: the bench commands judged with the thesis's 0.68,0.68,0.1 while docs/accuracy.md's
 // figures use 0.6,0.6,0.5.
 TEST_F(ConsoleCli, BenchSmoothingDefaultsMatchTheAccuracyDocs) {
-  for (const auto& [command, option] : {std::pair{"bench recon", "--fmart-smoothing"},
-                                        std::pair{"bench recon-race", "--smoothing"},
-                                        std::pair{"bench piv3d", "--fmart-smoothing"}}) {
+  for (const auto& [command, option] : {std::pair{"bench recon", "--smooth"},
+                                        std::pair{"bench recon-race", "--smooth"},
+                                        std::pair{"bench piv3d", "--smooth"}}) {
     const CliResult r = run_tomorig(std::string(command) + " --help");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto at = r.out.find(std::string(option) + " TEXT=");
@@ -151,6 +151,74 @@ TEST_F(ConsoleCli, TooLargeWindowIsNamedAsTheUserWroteIt) {
   EXPECT_NE(r.err.find("--window 16,16,32: z = 32"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("use at most 24 along z"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(*dir_ / "w.h5"));
+}
+
+// Issue 23: process, inspect, reconstruct (and every summarising command) take --json [FILE] with
+// the same meaning: stdout alone, or the file with the text kept on stdout.
+TEST_F(ConsoleCli, ProcessInspectAndReconstructTakeJsonFile) {
+  const fs::path pj = *dir_ / "process.json";
+  const CliResult p = run_tomorig(process("process-json.h5", "--json " + shell_quoted(pj.string())));
+  ASSERT_EQ(p.exit_code, 0) << p.err;
+  EXPECT_NE(p.out.find("wrote "), std::string::npos) << p.out;
+  std::ifstream process_in(pj);
+  const nlohmann::json process_summary = nlohmann::json::parse(process_in);
+  EXPECT_EQ(process_summary["command"], "process");
+  EXPECT_EQ(process_summary["sets_in_file"], 2);
+
+  // The word after --json is its file only if it ends in .json: here it is the session.
+  const CliResult i = run_tomorig("inspect --json " + shell_quoted(session_));
+  ASSERT_EQ(i.exit_code, 0) << i.err;
+  const nlohmann::json inspect_summary = nlohmann::json::parse(i.out);
+  EXPECT_EQ(inspect_summary["command"], "inspect");
+  EXPECT_EQ(inspect_summary["sets"], 2);
+
+  const fs::path rj = *dir_ / "recon.json";
+  const CliResult r = run_tomorig("reconstruct " + shell_quoted(session_) +
+                                  " --calib truth --grid 24,24,32,0.0195 --algorithm mlos -o " +
+                                  shell_quoted((*dir_ / "vj.h5").string()) + " --json=" + shell_quoted(rj.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("wrote "), std::string::npos) << r.out;
+  std::ifstream recon_in(rj);
+  const nlohmann::json recon_summary = nlohmann::json::parse(recon_in);
+  EXPECT_EQ(recon_summary["command"], "reconstruct");
+  EXPECT_TRUE(recon_summary["volumes"].contains("a")) << recon_summary.dump();
+}
+
+// Issue 23: process said nothing inside a set (minutes on a real grid); -v logs each step.
+TEST_F(ConsoleCli, ProcessReportsTheStepsInsideASet) {
+  const CliResult r = run_tomorig(process("steps.h5", "--sets 1 -v"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* step : {"debug: set 0: reading and preprocessing", "debug: set 0: reconstructing A",
+                           "debug: set 0: reconstructing B", "debug: set 0: correlating"})
+    EXPECT_NE(r.err.find(step), std::string::npos) << step << "\n" << r.err;
+  EXPECT_EQ(r.err.find("set 1"), std::string::npos) << r.err;  // --sets 1: the first set only
+}
+
+// Issue 23: one spelling per thing; the old ones still work with a deprecation warning.
+TEST_F(ConsoleCli, OldSpellingsWarnAndStillWork) {
+  const CliResult r = run_tomorig("process --session " + shell_quoted(session_) +
+                                  " --calib truth --grid 32,32,48,0.0195 --window 16,16,16 --overlap 0.5 "
+                                  "--deformation-passes 1 --max-sets 1 --dt-ns 50000 -o " +
+                                  shell_quoted((*dir_ / "old.h5").string()) + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["sets_in_file"], 1);
+  for (const char* warning : {"warning: --session is deprecated", "warning: --max-sets is deprecated",
+                              "warning: --dt-ns is deprecated"})
+    EXPECT_NE(r.err.find(warning), std::string::npos) << warning << "\n" << r.err;
+  const CliResult help = run_tomorig("process --help");
+  EXPECT_EQ(help.out.find("--max-sets"), std::string::npos) << "old spellings are hidden from --help";
+  EXPECT_NE(help.out.find("--chain"), std::string::npos) << help.out;
+}
+
+// Issue 23: `record -o copy.h5 --sets 100` after a 10-set replay never ended: record now stops
+// by itself after a minute without a set.
+TEST_F(ConsoleCli, RecordHasADefaultIdleTimeout) {
+  const CliResult help = run_tomorig("record --help");
+  ASSERT_EQ(help.exit_code, 0) << help.err;
+  const auto at = help.out.find("--idle-timeout FLOAT=60");
+  EXPECT_NE(at, std::string::npos) << help.out;
+  const CliResult bad = run_tomorig("record -o x.h5 --idle-timeout -1");
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
 }
 
 }  // namespace

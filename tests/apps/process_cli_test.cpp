@@ -42,7 +42,7 @@ class ProcessCli : public ::testing::Test {
     if (!tomorig_built()) GTEST_SKIP() << "tomorig binary not built";
   }
   static std::string base_args(const std::string& session, const fs::path& out) {
-    return "process --session " + shell_quoted(session) + " --calib truth " + kGrid + " -o " + shell_quoted(out.string());
+    return "process " + shell_quoted(session) + " --calib truth " + kGrid + " -o " + shell_quoted(out.string());
   }
   static std::string process_args(const std::string& session, const fs::path& out) {
     return base_args(session, out) + " " + kCorrelation;
@@ -70,6 +70,7 @@ TEST_F(ProcessCli, MeanFieldMatchesTheAnalyticFlow) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json summary = nlohmann::json::parse(r.out);
   EXPECT_EQ(summary["sets_in_file"], kSets);
+  EXPECT_EQ(summary["command"], "process");
   EXPECT_NE(r.err.find("sets/s"), std::string::npos) << r.err;  // the progress line
   EXPECT_TRUE(fs::exists(*dir_ / "mean.xdmf"));
 
@@ -296,32 +297,42 @@ TEST_F(ProcessCli, BadInputIsExitCode2WithAReason) {
     std::string args, needle;
   };
   for (const Case& c : {
-           Case{process_args(no_dt, out), "--dt-ns"},
-           Case{process_args(session_, out) + " --dt-ns -3", "--dt-ns -3 must be > 0"},
+           Case{process_args(no_dt, out), "--dt (e.g. --dt 80us)"},
+           Case{process_args(session_, out) + " --dt-ns -3", "--dt -3ns must be > 0"},
+           Case{process_args(session_, out) + " --dt 80", "--dt '80' is not valid: the unit is missing"},
+           Case{process_args(session_, out) + " --sets 2:4", "write N or 0:N"},
            Case{base_args(session_, out) + " --window 128,32,32", "larger than the volume"},
            Case{base_args(session_, out) + " --window 12,x", "--window '12,x' is not valid"},
            Case{process_args(session_, out) + " --algorithm nope", "nope"},
            Case{"process --session nope.h5 -o " + shell_quoted(out.string()), "does not exist"},
+           Case{"process -o " + shell_quoted(out.string()), "no session given"},
        }) {
     const CliResult r = run_tomorig(c.args);
     EXPECT_EQ(r.exit_code, 2) << c.args << "\n" << r.err;
     EXPECT_NE(r.err.find(c.needle), std::string::npos) << c.args << "\n" << r.err;
     EXPECT_FALSE(fs::exists(out)) << c.args;
   }
+  // The spellings of before the one vocabulary (issue 23) still work, each with a deprecation note.
+  const CliResult old = run_tomorig("process --session nope.h5 --max-sets 1 --config chain.toml --dt-ns 5 -o " +
+                                    shell_quoted(out.string()));
+  EXPECT_EQ(old.exit_code, 2) << old.err;
+  for (const char* spelling : {"--session is deprecated", "--max-sets is deprecated", "--config is deprecated",
+                               "--dt-ns is deprecated"})
+    EXPECT_NE(old.err.find(spelling), std::string::npos) << spelling << "\n" << old.err;
 }
 
 TEST_F(ProcessCli, RefusesResultsOfAnotherSessionOrGrid) {
   // A results file of one set of the dt-less copy (dt given on the command line)...
   const std::string other = session_without_dt(session_, *dir_ / "other.h5");
   const fs::path out = *dir_ / "other_results.h5";
-  const CliResult made = run_tomorig(process_args(other, out) + " --dt-ns 100000");
+  const CliResult made = run_tomorig(process_args(other, out) + " --dt 100us");
   ASSERT_EQ(made.exit_code, 0) << made.err;
   // ...is not resumed by a run on another session,
   const CliResult wrong_session = run_tomorig(process_args(session_, out));
   EXPECT_EQ(wrong_session.exit_code, 2) << wrong_session.err;
   EXPECT_NE(wrong_session.err.find("belongs to another session"), std::string::npos) << wrong_session.err;
   // nor by a run of the same session on another grid,
-  std::string args = process_args(other, out) + " --dt-ns 100000";
+  std::string args = process_args(other, out) + " --dt 100us";
   args.replace(args.find("96,96,160"), 9, "64,64,160");
   const CliResult wrong_grid = run_tomorig(args);
   EXPECT_EQ(wrong_grid.exit_code, 2) << wrong_grid.err;
@@ -401,9 +412,9 @@ TEST(ProcessRealData, FluidimageDoubleFrameProcessesEndToEnd) {
   // The sample records no pulse separation: refused with a reason, nothing written.
   const CliResult no_dt = run_tomorig(process);
   EXPECT_EQ(no_dt.exit_code, 2) << no_dt.err;
-  EXPECT_NE(no_dt.err.find("--dt-ns"), std::string::npos) << no_dt.err;
+  EXPECT_NE(no_dt.err.find("--dt (e.g. --dt 80us)"), std::string::npos) << no_dt.err;
   EXPECT_FALSE(fs::exists(results));
-  const CliResult r = run_tomorig(process + " --dt-ns 1000000");
+  const CliResult r = run_tomorig(process + " --dt 1ms");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["nodes"], nlohmann::json::array({14, 14, 6}));

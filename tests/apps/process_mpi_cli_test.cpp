@@ -184,7 +184,7 @@ TEST_F(ProcessMpi, BadInputIsReportedOnceByRankZeroWithExitCode2) {
   bad_dt.insert(bad_dt.end(), {"--dt-ns", "-5"});
   TomorigProcess dt_job(mpirun_args(3, bad_dt), kMpirun);
   EXPECT_EQ(dt_job.wait(), 2) << dt_job.err();
-  const std::string dt_message = "error: --dt-ns -5 must be > 0";
+  const std::string dt_message = "error: --dt -5ns must be > 0";
   const std::size_t first = dt_job.err().find(dt_message);
   ASSERT_NE(first, std::string::npos) << dt_job.err();
   EXPECT_EQ(dt_job.err().find(dt_message, first + 1), std::string::npos) << dt_job.err();

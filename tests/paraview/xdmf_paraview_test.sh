@@ -16,7 +16,7 @@ trap 'rm -rf "$work"' EXIT
 cd "$work"
 "$tomorig" simulate --sets 3 --ppp 0.05 --seed 11 -o s.h5 >/dev/null
 # A small grid: 3 x 3 x 5 vectors per set, a few seconds.
-"$tomorig" process --session s.h5 --calib truth --grid 32,32,48,0.0195 --window 16,16,16 --overlap 0.5 \
+"$tomorig" process s.h5 --calib truth --grid 32,32,48,0.0195 --window 16,16,16 --overlap 0.5 \
   --deformation-passes 1 -o r.h5 >/dev/null 2>&1
-"$tomorig" reconstruct --session s.h5 --calib truth --grid 24,24,32,0.0195 --set 1 -o v.h5 >/dev/null 2>&1
+"$tomorig" reconstruct s.h5 --calib truth --grid 24,24,32,0.0195 --set 1 -o v.h5 >/dev/null 2>&1
 pvpython --force-offscreen-rendering "$here/check_xdmf.py" results r.xdmf r.h5 volume v.xdmf v.h5

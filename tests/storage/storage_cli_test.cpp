@@ -104,6 +104,7 @@ TEST_F(CliTest, ImportThenInspect) {
   const RunResult r = run("import" + cams + " --dt-us 50 --pixel-pitch-um 6.5 --out " + quote(out.string()));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("imported 1 set from 2 cameras"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("--dt-us is deprecated"), std::string::npos) << r.err;  // the old spelling still works
 
   const auto j = nlohmann::json::parse(run("inspect --json " + quote(out.string())).out);
   EXPECT_EQ(j["sets"], 1);
@@ -113,13 +114,13 @@ TEST_F(CliTest, ImportThenInspect) {
   EXPECT_EQ(j["dt_ns"]["min"], 50000);
 
   // Again without --overwrite: the file exists, bad input.
-  const RunResult again = run("import" + cams + " --dt-us 50 --out " + quote(out.string()));
+  const RunResult again = run("import" + cams + " --dt 50us --out " + quote(out.string()));
   EXPECT_EQ(again.exit_code, 2);
   EXPECT_NE(again.err.find("already exists"), std::string::npos) << again.err;
 
   const RunResult no_dt = run("import" + cams + " --out " + quote((dir_ / "x.h5").string()));
   EXPECT_EQ(no_dt.exit_code, 2);
-  EXPECT_NE(no_dt.err.find("--dt-us"), std::string::npos) << no_dt.err;
+  EXPECT_NE(no_dt.err.find("--dt with its unit"), std::string::npos) << no_dt.err;
 }
 
 }  // namespace

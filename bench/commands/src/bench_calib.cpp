@@ -149,7 +149,8 @@ void add_bench_calib_command(CLI::App& bench) {
   cmd->add_option("--models", args->models, "Camera models, e.g. pinhole,rational2")->delimiter(',')->capture_default_str();
   cmd->add_option("--distortion-px", args->distortion_px, "Radial lens distortion at the image corner (full-size px)")
       ->capture_default_str();
-  cmd->add_option("--json", args->json_out, "Write the JSON here (default: stdout)");
+  cmd->add_option("--json", args->json_out, "Write the JSON to FILE (.json); --json alone, '-' or none: stdout")
+      ->expected(0, 1);
   cmd->callback([args] { run(*args); });
 }
 

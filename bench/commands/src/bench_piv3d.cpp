@@ -15,6 +15,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "tomorig/core/cli_vocabulary.h"
 #include "bench_common.h"
 #include "bench_recon_tuning.h"
 #include "tomorig/pipeline/correlation_args.h"
@@ -87,7 +88,7 @@ Vec3d parse_sigma(const std::string& text) {
   if (text == "0") return {};
   double v[3];
   if (std::sscanf(text.c_str(), "%lf,%lf,%lf", &v[0], &v[1], &v[2]) != 3 || !(v[0] >= 0 && v[1] >= 0 && v[2] >= 0))
-    throw bad_input(fmt::format("--fmart-smoothing '{}' is not valid: give sx,sy,sz in voxels (>= 0), or 0", text));
+    throw bad_input(fmt::format("--smooth '{}' is not valid: give sx,sy,sz in voxels (>= 0), or 0", text));
   return {v[0], v[1], v[2]};
 }
 
@@ -331,15 +332,17 @@ void add_bench_piv3d_command(CLI::App& bench) {
   cmd->add_option("--mlos-threshold", args->mlos_threshold,
                   "MLOS empty-pixel fraction of the image maximum (negative: the library default)")
       ->capture_default_str();
-  cmd->add_option("--fmart-smoothing", args->fmart_smoothing,
+  cmd->add_option("--smooth", args->fmart_smoothing,
                   "Gaussian sigma x,y,z (voxel) applied to FMART volumes before correlation, as the thesis did; 0: none")
       ->capture_default_str();
+  cli::add_deprecated_option(*cmd, "--fmart-smoothing", args->fmart_smoothing, "--smooth");
   cmd->add_option("--seed", args->seed, "Random seed of the particle field")->capture_default_str();
   cmd->add_option("--threads", args->threads, "OpenMP threads (0: all cores)")->capture_default_str();
   cmd->add_option("--errors-csv", args->errors_csv,
                   "Append one CSV line per node (source, ppp, i, j, k, nx, position, measured and true displacement "
                   "in voxel, status, peak) to this file");
-  cmd->add_option("--json", args->json_out, "Write the JSON here ('-' or empty: stdout)");
+  cmd->add_option("--json", args->json_out, "Write the JSON to FILE (.json); --json alone, '-' or none: stdout")
+      ->expected(0, 1);
   cmd->callback([args] { run(*args); });
 }
 

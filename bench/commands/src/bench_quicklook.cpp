@@ -197,7 +197,8 @@ void add_bench_quicklook_command(CLI::App& bench) {
   cmd->add_option("--preview", args->preview, "Preview volume: on, off, mlos or ment")->capture_default_str();
   cmd->add_option("--publish", args->publish, "Where the quick-look publishes (none: nowhere)")->capture_default_str();
   cmd->add_option("--folder", args->folder, "Folder for the recorded session (removed after)")->capture_default_str();
-  cmd->add_option("--json", args->json_out, "Write the JSON here ('-' or empty: stdout)");
+  cmd->add_option("--json", args->json_out, "Write the JSON to FILE (.json); --json alone, '-' or none: stdout")
+      ->expected(0, 1);
   cmd->callback([args] { run(*args); });
 }
 

@@ -17,6 +17,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "tomorig/core/cli_vocabulary.h"
 #include "bench_common.h"
 #include "bench_recon_tuning.h"
 #include "tomorig/pipeline/report_json.h"
@@ -102,7 +103,7 @@ Vec3d parse_sigma(const std::string& text) {
   if (text == "0") return {};
   double v[3];
   if (std::sscanf(text.c_str(), "%lf,%lf,%lf", &v[0], &v[1], &v[2]) != 3 || !(v[0] >= 0 && v[1] >= 0 && v[2] >= 0))
-    throw bad_input(fmt::format("--fmart-smoothing '{}' is not valid: give sx,sy,sz in voxels (>= 0), or 0 for none", text));
+    throw bad_input(fmt::format("--smooth '{}' is not valid: give sx,sy,sz in voxels (>= 0), or 0 for none", text));
   return {v[0], v[1], v[2]};
 }
 
@@ -196,7 +197,7 @@ void run(const BenchReconArgs& args) {
 
   const Vec3d smoothing = parse_sigma(args.fmart_smoothing);
   const int exposures = args.exposures > 0 ? args.exposures : default_exposures(args.case_name);
-  if (exposures > 2) throw bad_input(fmt::format("--exposures {} is not valid: give 1 (A) or 2 (A and B)", exposures));
+  if (exposures > 2) throw bad_input(fmt::format("--exposures {} is not valid: give --exposure a (A) or both (A and B)", exposures));
   const bool peaks_reset = reset_peak_rss();
   nlohmann::json results = nlohmann::json::array();
   VoxelGrid case_grid;
@@ -364,23 +365,40 @@ void add_bench_recon_command(CLI::App& bench) {
   cmd->add_option("--grid", args->grid, "Override the case's grid: nx,ny,nz,voxel_mm[,cx,cy,cz]");
   cmd->add_option("--seed", args->seed, "Random seed of the particle field")->capture_default_str();
   cmd->add_option("--threads", args->threads, "OpenMP threads (0: all cores)")->capture_default_str();
-  cmd->add_option("--fmart-smoothing", args->fmart_smoothing,
+  cmd->add_option("--smooth", args->fmart_smoothing,
                   "Gaussian sigma x,y,z (voxel) applied to FMART volumes before judging them, as the thesis "
                   "did; 0: none")
       ->capture_default_str();
-  cmd->add_option("--session", args->session,
-                  "Reconstruct exposure A of a recorded session instead (no truth): reports time, blob count and the "
-                  "intensity-versus-depth profile");
+  cli::add_deprecated_option(*cmd, "--fmart-smoothing", args->fmart_smoothing, "--smooth");
+  cli::add_session_argument(*cmd, args->session,
+                            "Reconstruct exposure A of a recorded session instead (no truth): reports time, blob count "
+                            "and the intensity-versus-depth profile");
   cmd->add_option("--calib", args->calib, "With --session: calibration file (TOML), or 'truth'");
   cmd->add_option("--set", args->set, "With --session: set index, 0-based")->capture_default_str();
-  cmd->add_option("--exposures", args->exposures,
-                  "1: reconstruct exposure A; 2: A and B, times summed (a double exposure); 0: the case's "
-                  "default (2 for size-thesis-spray, else 1)")
-      ->capture_default_str();
+  cmd->add_option_function<std::string>(
+         "--exposure",
+         [args](const std::string& e) {
+           if (e == "a" || e == "A") args->exposures = 1;
+           else if (e == "both") args->exposures = 2;
+           else
+             throw bad_input(fmt::format("--exposure '{}' is not valid here: bench recon reconstructs a (exposure A) "
+                                         "or both (A and B, times summed: a double exposure)", e));
+         },
+         "a: reconstruct exposure A; both: A and B, times summed (a double exposure); default: both for "
+         "size-thesis-spray, else a");
+  cmd->add_option_function<int>(
+         "--exposures",
+         [args](int n) {
+           cli::warn_deprecated("--exposures 1|2", "--exposure a|both");
+           args->exposures = n;
+         },
+         "deprecated: use --exposure a|both")
+      ->group("");
   cmd->add_option("--max-truth-mb", args->max_truth_mb,
                   "Judge Q only if the dense truth volume fits this many MB (else speed and memory only)")
       ->capture_default_str();
-  cmd->add_option("--json", args->json_out, "Write the JSON here ('-' or empty: stdout)");
+  cmd->add_option("--json", args->json_out, "Write the JSON to FILE (.json); --json alone, '-' or none: stdout")
+      ->expected(0, 1);
   cmd->callback([args] { run(*args); });
 }
 

@@ -15,6 +15,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "tomorig/core/cli_vocabulary.h"
 #include "bench_common.h"
 #include "bench_recon_tuning.h"
 #include "tomorig/pipeline/session_geometry.h"
@@ -52,7 +53,7 @@ Vec3d parse_smoothing(const std::string& text) {
   if (text == "0") return {};
   double v[3];
   if (std::sscanf(text.c_str(), "%lf,%lf,%lf", &v[0], &v[1], &v[2]) != 3 || !(v[0] >= 0 && v[1] >= 0 && v[2] >= 0))
-    throw bad_input(fmt::format("--smoothing '{}' is not valid: give sx,sy,sz in voxels (>= 0), or 0 for none", text));
+    throw bad_input(fmt::format("--smooth '{}' is not valid: give sx,sy,sz in voxels (>= 0), or 0 for none", text));
   return {v[0], v[1], v[2]};
 }
 
@@ -266,14 +267,16 @@ void add_bench_recon_race_command(CLI::App& bench) {
   cmd->add_option("--q-target", args->q_target,
                   "Windowed Q both must reach (0: the lower of the two algorithms' best Q at each density)")
       ->capture_default_str();
-  cmd->add_option("--smoothing", args->smoothing,
+  cmd->add_option("--smooth", args->smoothing,
                   "Gaussian sigma x,y,z (voxel) applied to both volumes before judging, as the thesis did for "
                   "FMART; 0: none")
       ->capture_default_str();
+  cli::add_deprecated_option(*cmd, "--smoothing", args->smoothing, "--smooth");
   cmd->add_option("--grid", args->grid, "Override the case's grid: nx,ny,nz,voxel_mm[,cx,cy,cz]");
   cmd->add_option("--seed", args->seed, "Random seed of the particle field")->capture_default_str();
   cmd->add_option("--threads", args->threads, "OpenMP threads (0: all cores)")->capture_default_str();
-  cmd->add_option("--json", args->json_out, "Write the JSON here ('-' or empty: stdout)");
+  cmd->add_option("--json", args->json_out, "Write the JSON to FILE (.json); --json alone, '-' or none: stdout")
+      ->expected(0, 1);
   cmd->callback([args] { run(*args); });
 }
 

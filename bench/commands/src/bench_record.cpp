@@ -152,7 +152,8 @@ void add_bench_record_command(CLI::App& bench) {
   cmd->add_option("--side", args->side, "Frame width and height, pixels (Mono16)")->capture_default_str();
   cmd->add_option("--folder", args->folder, "Folder on the disk to measure (files are removed after)")
       ->capture_default_str();
-  cmd->add_option("--json", args->json_out, "Write the JSON here ('-' or empty: stdout)");
+  cmd->add_option("--json", args->json_out, "Write the JSON to FILE (.json); --json alone, '-' or none: stdout")
+      ->expected(0, 1);
   cmd->callback([args] { run(*args); });
 }
 

@@ -173,7 +173,8 @@ void add_bench_stream_command(CLI::App& bench) {
   cmd->add_option("--warmup", args->warmup_sets, "Sets sent before the measurement starts")->capture_default_str();
   cmd->add_flag("--plain-malloc", args->plain_malloc,
                 "Leave glibc's allocator settings alone (to measure what keep_receive_buffers() saves)");
-  cmd->add_option("--json", args->json_out, "Write the JSON here ('-' or empty: stdout)");
+  cmd->add_option("--json", args->json_out, "Write the JSON to FILE (.json); --json alone, '-' or none: stdout")
+      ->expected(0, 1);
   cmd->callback([args] { run(*args); });
 }
 

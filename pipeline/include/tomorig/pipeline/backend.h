@@ -68,6 +68,18 @@ struct BackendRankFigures {
   double busy_seconds = 0.0;      // the sum of its sets' times (read to result; overlapped sets both count)
 };
 
+// The work in hand inside a set (a set can take minutes), for progress within a set.
+struct BackendStep {
+  enum class Kind { preprocessing, reconstructing, correlating };
+  std::uint64_t set = 0;
+  Kind kind = Kind::preprocessing;
+  char exposure = 'A';  // reconstructing: 'A' or 'B'
+  int iteration = 0;    // reconstructing with SMART/FMART: iterations done of `iterations`; else 0
+  int iterations = 0;
+  // "set 3: reconstructing B, iteration 4/7", "set 3: correlating"
+  std::string text() const;
+};
+
 struct BackendHooks {
   // Asked between sets; true stops after the set in hand, leaving a valid, resumable file.
   std::function<bool()> should_stop;
@@ -76,6 +88,10 @@ struct BackendHooks {
   // The work is about to start: this many sets to do (the resumed ones left out).
   std::function<void(std::uint64_t sets_to_do)> started;
   std::function<void(const BackendSetDone&)> set_done;
+  // A step inside a set started (and each reconstruction iteration). With reconstruction and
+  // correlation overlapped it is called from two threads (one set reconstructing, the previous
+  // one correlating). Not called under MPI.
+  std::function<void(const BackendStep&)> step;
 };
 
 struct BackendReport {

@@ -1,7 +1,7 @@
 #pragma once
-// A picture of one z-slice of a displacement field, for reports: each node a square cell whose
-// grey level is the in-plane displacement magnitude (white = the slice's largest), with a short
-// dark line showing the in-plane direction; invalid nodes are black.
+// A picture of one z-slice of a displacement field, for reports (quicklook::vector_slice_plot):
+// each node a cell whose grey level is the in-plane displacement magnitude (colour bar), an
+// arrow per valid node with a reference arrow for scale, axes; invalid nodes are black.
 #include <filesystem>
 #include <vector>
 
@@ -12,6 +12,6 @@ namespace tomorig::pipeline {
 // `displacement` and `counted` hold nx * ny * nz nodes (x fastest); nodes with counted == 0 are
 // drawn black. Writes an 8-bit PNG through storage::write_png.
 void write_slice_png(const std::filesystem::path& file, int nx, int ny, int nz, int k,
-                     const std::vector<Vec3d>& displacement, const std::vector<bool>& counted, int cell = 24);
+                     const std::vector<Vec3d>& displacement, const std::vector<bool>& counted);
 
 }  // namespace tomorig::pipeline

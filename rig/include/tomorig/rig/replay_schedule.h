@@ -17,7 +17,8 @@ struct ReplayRate {
 // "recorded", "max" or a rate in Hz (> 0); bad_input otherwise.
 ReplayRate parse_replay_rate(const std::string& text);
 
-// Half-open range [first, last) of set indices; "A:B", "A:" (to the end), ":B", "A" (one set).
+// Half-open range [first, last) of set indices, from the one set syntax (core/set_selection.h):
+// "N" (the first N), "A:B", "A:" (to the end), ":B", or consecutive "A-B".
 struct SetRange {
   std::uint64_t first = 0;
   std::uint64_t last = 0;

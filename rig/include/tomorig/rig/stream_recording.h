@@ -25,7 +25,11 @@ struct StreamRecordingOptions {
   bool allow_remote = false;                  // bind beyond loopback (needs a token)
   std::string token;                          // the stream's shared secret; empty: $TOMORIG_STREAM_TOKEN
   std::optional<std::uint64_t> sets;          // stop after this many sets; none: at the sender's end
-  std::optional<double> idle_timeout_s;       // stop when no message arrived for this long
+  // Stop when no set arrived for this long (counted from the start until the first set); 0: wait
+  // for ever. A rig triggers at 1 Hz or faster, so a minute without a set means the acquisition
+  // has stopped (issue 23: a record after a replay that had ended waited for ever); until the
+  // first set the minute also covers the start of the sender.
+  double idle_timeout_s = 60.0;
   std::string compression = "none";           // "none" | "bitshuffle-lz4"
   RecorderOptions recorder;                   // out, overwrite, disk reserve, largest set
   bool status_line = false;                   // "record: 12 sets  41.9 MB/s to disk ..." on stderr
