@@ -139,6 +139,7 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
   });
   // Window b: its sums, and QB(s) = sum_y w(y) B(y) w(y - s) at the 27 lags.
   double qb[27] = {};
+  alignas(16) float qb4[9][4] = {};  // per (dy, dz) row, x lags as 4 float lanes (the 4th unused)
   for_window_entries(ob, [&](int i, int j, int k, float value) {
     const float weight = wx_[i] * wy_[j] * wz_[k];
     const double w2 = static_cast<double>(weight) * weight;
@@ -146,7 +147,8 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
     sb.weighted += w2 * value;
     sb.weighted_square += w2 * value * value;
     const float wb = weight * value;
-    float px[3], py[3], pz[3];
+    float py[3], pz[3];
+    alignas(16) float px[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     for (int d = -1; d <= 1; ++d) {
       px[d + 1] = wx_[wrap(i - d, w.x)];
       py[d + 1] = wy_[wrap(j - d, w.y)];
@@ -155,12 +157,13 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
     for (int dz = 0; dz < 3; ++dz)
       for (int dy = 0; dy < 3; ++dy) {
         const float f = wb * pz[dz] * py[dy];
-        double* q = qb + 3 * (dy + 3 * dz);
-        q[0] += f * px[0];
-        q[1] += f * px[1];
-        q[2] += f * px[2];
+        float* q = qb4[dy + 3 * dz];
+#pragma omp simd
+        for (int l = 0; l < 4; ++l) q[l] += f * px[l];
       }
   });
+  for (int r = 0; r < 9; ++r)
+    for (int l = 0; l < 3; ++l) qb[3 * r + l] = qb4[r][l];
   const double mean_a = sa.sum / n, mean_b = sb.sum / n;
   // sum w^2 (A - mean)^2 over the whole window, the empty voxels included.
   const double energy_a = sa.weighted_square - 2 * mean_a * sa.weighted + mean_a * mean_a * weight_energy_;
@@ -215,14 +218,32 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
         }
       continue;
     }
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const float f = wa * pz[dz + 1] * py[dy + 1] * px[dx + 1];
-          const int l = lag_index(dx, dy, dz);
-          p[l] += f * b_at(wrap(i + dx, w.x), wrap(j + dy, w.y), wrap(k + dz, w.z));
-          qa[l] += f;
+    // Edge of the window: the lags wrap around it (as the FFT's). Each axis's three wrapped
+    // coordinates are looked up once; a coordinate outside the volume reads 0.
+    std::ptrdiff_t ox[3], oy[3], oz[3];
+    bool in_x[3], in_y[3], in_z[3];
+    for (int d = -1; d <= 1; ++d) {
+      const int x = start.x + wrap(i + d, w.x), y = start.y + wrap(j + d, w.y), z = start.z + wrap(k + d, w.z);
+      in_x[d + 1] = x >= 0 && x < vb.nx;
+      in_y[d + 1] = y >= 0 && y < vb.ny;
+      in_z[d + 1] = z >= 0 && z < vb.nz;
+      ox[d + 1] = x;
+      oy[d + 1] = static_cast<std::ptrdiff_t>(y) * static_cast<std::ptrdiff_t>(sy);
+      oz[d + 1] = static_cast<std::ptrdiff_t>(z) * static_cast<std::ptrdiff_t>(sz);
+    }
+    for (int dz = 0; dz < 3; ++dz)
+      for (int dy = 0; dy < 3; ++dy) {
+        const float fzy = wa * pz[dz] * py[dy];
+        const bool row_in = in_z[dz] && in_y[dy];
+        const float* row = vb.data + (row_in ? oz[dz] + oy[dy] : 0);
+        double* pl = p + 3 * (dy + 3 * dz);
+        double* ql = qa + 3 * (dy + 3 * dz);
+        for (int dx = 0; dx < 3; ++dx) {
+          const float f = fzy * px[dx];
+          pl[dx] += f * (row_in && in_x[dx] ? row[ox[dx]] : 0.0f);
+          ql[dx] += f;
         }
+      }
   }
   for (int r = 0; r < 9; ++r)
     for (int l = 0; l < 3; ++l) {

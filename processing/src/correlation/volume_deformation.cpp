@@ -148,16 +148,6 @@ float sample_bspline(const VolumeView& c, float x, float y, float z) {
   return result;
 }
 
-// Whether the support mask (empty: everywhere) marks the voxel nearest to (x, y, z); outside
-// the volume the sample is 0 anyway except within half a voxel, which the clamp keeps.
-bool has_signal(const std::vector<std::uint8_t>& support, const VolumeView& v, float x, float y, float z) {
-  if (support.empty()) return true;
-  const int i = std::clamp(floor_int(x + 0.5f), 0, v.nx - 1);
-  const int j = std::clamp(floor_int(y + 0.5f), 0, v.ny - 1);
-  const int k = std::clamp(floor_int(z + 0.5f), 0, v.nz - 1);
-  return support[v.linear(i, j, k)] != 0;
-}
-
 }  // namespace
 
 void locate_axis(double p, double origin, double spacing, int n, int& i0, double& frac) {
@@ -322,6 +312,105 @@ std::vector<std::uint8_t> signal_support(const VolumeView& v, float relative_thr
   return spread;
 }
 
+namespace {
+
+// The predictor's x-interpolation is the same on every row: each voxel's cell (left node) and
+// fraction, found once per deformation instead of per voxel (locate_axis in double).
+struct AxisCells {
+  std::vector<int> cell;
+  std::vector<float> frac;
+};
+
+AxisCells axis_cells(int voxels, int factor, double offset, double origin, double spacing, int nodes) {
+  AxisCells c;
+  c.cell.resize(voxels);
+  c.frac.resize(voxels);
+  for (int i = 0; i < voxels; ++i) {
+    double frac;
+    locate_axis(i * factor + offset, origin, spacing, nodes, c.cell[i], frac);
+    c.frac[i] = static_cast<float>(frac);
+  }
+  return c;
+}
+
+// The 4 x 4 x 4 B-spline sum of an interior sample: the 16 rows of 4 coefficients weighted by
+// wz * wy into 4 lanes, then the lanes by wx (two packed multiply-adds per row).
+inline float bspline_interior(const float* base, std::size_t sy, std::size_t sz, const float wx[4], const float wy[4],
+                              const float wz[4]) {
+  float acc[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  for (int dk = 0; dk < 4; ++dk)
+    for (int dj = 0; dj < 4; ++dj) {
+      const float w = wz[dk] * wy[dj];
+      const float* row = base + dk * sz + dj * sy;
+#pragma omp simd
+      for (int l = 0; l < 4; ++l) acc[l] += w * row[l];
+    }
+  return (wx[0] * acc[0] + wx[1] * acc[1]) + (wx[2] * acc[2] + wx[3] * acc[3]);
+}
+
+// Per-thread buffers of deform_row, sized once per thread.
+struct RowScratch {
+  std::vector<float> x, y, z;  // source positions of the row's voxels
+  std::vector<int> kept;       // the voxels whose source has signal
+  explicit RowScratch(int n) : x(n), y(n), z(n), kept(n) {}
+};
+
+// One deformed row: out[i] = v(i + sign * h(i), j + ..., k + ...), 0 where the support (if any)
+// says the source has no signal. The support test runs without branches over the whole row
+// and lists the voxels to interpolate (a mask of irregular particle images mispredicts any
+// per-voxel branch); only those are evaluated.
+void deform_row(const VolumeView& v, const std::uint8_t* support, Interpolation interpolation, int j, int k,
+                float sign, const float* hx, const float* hy, const float* hz, RowScratch& s, float* out) {
+  const std::size_t sy = static_cast<std::size_t>(v.nx), sz = sy * static_cast<std::size_t>(v.ny);
+  const int n = v.nx;
+  float* xs = s.x.data();
+  float* ys = s.y.data();
+  float* zs = s.z.data();
+#pragma omp simd
+  for (int i = 0; i < n; ++i) {
+    xs[i] = i + sign * hx[i];
+    ys[i] = j + sign * hy[i];
+    zs[i] = k + sign * hz[i];
+  }
+  int* kept = s.kept.data();
+  int count = 0;
+  if (support) {
+    for (int i = 0; i < n; ++i) {
+      // The voxel nearest to the source position; outside the volume the sample is 0 anyway
+      // except within half a voxel, which the clamp keeps.
+      const int si = std::clamp(floor_int(xs[i] + 0.5f), 0, v.nx - 1);
+      const int sj = std::clamp(floor_int(ys[i] + 0.5f), 0, v.ny - 1);
+      const int sk = std::clamp(floor_int(zs[i] + 0.5f), 0, v.nz - 1);
+      kept[count] = i;
+      count += support[static_cast<std::size_t>(si) + sy * sj + sz * sk] != 0;
+    }
+    std::fill(out, out + n, 0.0f);
+  } else {
+    for (int i = 0; i < n; ++i) kept[i] = i;
+    count = n;
+  }
+  for (int m = 0; m < count; ++m) {
+    const int i = kept[m];
+    const float x = xs[i], y = ys[i], z = zs[i];
+    if (interpolation == Interpolation::trilinear) {
+      out[i] = sample_trilinear(v, x, y, z);
+      continue;
+    }
+    const int ii = floor_int(x), jj = floor_int(y), kk = floor_int(z);
+    if (ii >= 1 && jj >= 1 && kk >= 1 && ii + 2 < v.nx && jj + 2 < v.ny && kk + 2 < v.nz) {
+      float wx[4], wy[4], wz[4];
+      bspline_weights(x - ii, wx);
+      bspline_weights(y - jj, wy);
+      bspline_weights(z - kk, wz);
+      out[i] = bspline_interior(v.data + v.linear(ii - 1, jj - 1, kk - 1), sy, sz, wx, wy, wz);
+    } else {
+      out[i] = sample_bspline(v, x, y, z);
+    }
+  }
+}
+
+}  // namespace
+
 void deform_pair(const VolumeView& a, const VolumeView& b, const VectorField& predictor, int factor,
                  Interpolation interpolation, std::vector<float>& out_a, std::vector<float>& out_b, int threads,
                  const std::vector<std::uint8_t>& support_a, const std::vector<std::uint8_t>& support_b) {
@@ -330,28 +419,41 @@ void deform_pair(const VolumeView& a, const VolumeView& b, const VectorField& pr
   out_b.resize(b.count());
   const double offset = 0.5 * (factor - 1);  // full-grid position of a binned voxel's centre
   const float half = 0.5f / factor;           // half the displacement, in binned voxels
+  const AxisCells cells = axis_cells(a.nx, factor, offset, predictor.origin.x, predictor.spacing.x, predictor.nx);
+  const int nodes_x = predictor.nx;
+  const std::uint8_t* mask_a = support_a.empty() ? nullptr : support_a.data();
+  const std::uint8_t* mask_b = support_b.empty() ? nullptr : support_b.data();
 #pragma omp parallel num_threads(thread_count(threads))
   {
   const FlushDenormals flush;
   RowPredictor along_row(predictor);  // the predictor's y-z interpolation once per row
+  std::vector<float> hx(a.nx), hy(a.nx), hz(a.nx), column(3 * static_cast<std::size_t>(nodes_x));
+  RowScratch scratch(a.nx);
+  // Tiles of kTileRows rows in y run through every z: the 4 x (kTileRows + 3) coefficient rows
+  // an output slice of a tile reads stay in cache for the next slices, so each coefficient is
+  // fetched from memory about once (slice by slice, each was fetched 4 times).
+  constexpr int kTileRows = 16;
+  const int tiles = (a.ny + kTileRows - 1) / kTileRows;
 #pragma omp for schedule(dynamic, 1)
+  for (int tile = 0; tile < tiles; ++tile)
   for (int k = 0; k < a.nz; ++k)
-    for (int j = 0; j < a.ny; ++j) {
-      const std::size_t row = a.linear(0, j, k);
+    for (int j = tile * kTileRows; j < std::min(a.ny, (tile + 1) * kTileRows); ++j) {
       along_row.set_row(j * factor + offset, k * factor + offset);
+      const double* c = along_row.columns();
+      for (std::size_t m = 0; m < column.size(); ++m) column[m] = static_cast<float>(c[m]);
+      // Half the predicted displacement at every voxel of the row, in voxels of this level.
       for (int i = 0; i < a.nx; ++i) {
-        const Vec3f d = along_row.at(i * factor + offset);
-        const float hx = d.x * half, hy = d.y * half, hz = d.z * half;
-        const bool signal_a = has_signal(support_a, a, i - hx, j - hy, k - hz);
-        const bool signal_b = has_signal(support_b, b, i + hx, j + hy, k + hz);
-        if (interpolation == Interpolation::trilinear) {
-          out_a[row + i] = signal_a ? sample_trilinear(a, i - hx, j - hy, k - hz) : 0.0f;
-          out_b[row + i] = signal_b ? sample_trilinear(b, i + hx, j + hy, k + hz) : 0.0f;
-        } else {
-          out_a[row + i] = signal_a ? sample_bspline(a, i - hx, j - hy, k - hz) : 0.0f;
-          out_b[row + i] = signal_b ? sample_bspline(b, i + hx, j + hy, k + hz) : 0.0f;
-        }
+        const int cell = cells.cell[i];
+        const float* c0 = column.data() + 3 * static_cast<std::size_t>(cell);
+        const float* c1 = nodes_x > 1 ? c0 + 3 : c0;
+        const float f = cells.frac[i];
+        hx[i] = (c0[0] + f * (c1[0] - c0[0])) * half;
+        hy[i] = (c0[1] + f * (c1[1] - c0[1])) * half;
+        hz[i] = (c0[2] + f * (c1[2] - c0[2])) * half;
       }
+      const std::size_t row = a.linear(0, j, k);
+      deform_row(a, mask_a, interpolation, j, k, -1.0f, hx.data(), hy.data(), hz.data(), scratch, out_a.data() + row);
+      deform_row(b, mask_b, interpolation, j, k, +1.0f, hx.data(), hy.data(), hz.data(), scratch, out_b.data() + row);
     }
   }
 }

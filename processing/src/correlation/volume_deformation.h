@@ -51,6 +51,8 @@ class RowPredictor {
   explicit RowPredictor(const VectorField& field) : f_(field) {}
   void set_row(double y, double z);
   Vec3f at(double x) const;
+  // After set_row: x, y, z of the displacement per x-node, interpolated at the row's y, z.
+  const double* columns() const { return columns_.data(); }
 
  private:
   const VectorField& f_;
