@@ -19,23 +19,8 @@ inline int floor_int(float x) {
   return t - (x < static_cast<float>(t));
 }
 
-// One line of the recursive cubic B-spline prefilter (pole sqrt(3) - 2, mirror boundaries).
-void prefilter_line(float* c, int n) {
-  if (n < 2) return;
-  constexpr double pole = -0.2679491924311228;  // sqrt(3) - 2
-  constexpr double gain = 6.0;                  // (1 - pole)(1 - 1 / pole)
-  for (int k = 0; k < n; ++k) c[k] = static_cast<float>(c[k] * gain);
-  // Causal initialisation: the mirrored sum, truncated where pole^k is negligible.
-  const int horizon = std::min(n, 30);
-  double sum = c[0], zk = pole;
-  for (int k = 1; k < horizon; ++k, zk *= pole) sum += zk * c[k];
-  c[0] = static_cast<float>(sum);
-  for (int k = 1; k < n; ++k) c[k] = static_cast<float>(c[k] + pole * c[k - 1]);
-  c[n - 1] = static_cast<float>(pole / (pole * pole - 1.0) * (c[n - 1] + pole * c[n - 2]));
-  for (int k = n - 2; k >= 0; --k) c[k] = static_cast<float>(pole * (c[k + 1] - c[k]));
-}
-
-// prefilter_line on `width` lines at once: element k of every line is the contiguous row
+// The recursive cubic B-spline prefilter (pole sqrt(3) - 2, mirror boundaries) on `width`
+// lines of n elements at once: element k of every line is the contiguous row
 // base[k * stride .. k * stride + width).
 void prefilter_rows(float* base, std::size_t stride, int n, int width) {
   if (n < 2) return;
@@ -183,10 +168,22 @@ void bspline_prefilter(std::vector<float>& values, int nx, int ny, int nz, int t
 #pragma omp parallel num_threads(t)
   {
     const FlushDenormals flush;
-    // x: contiguous lines, one at a time.
+    // x: kLines lines at a time, transposed into a small buffer (element k of every line one
+    // contiguous row) so that the recursion runs over the lines in float lanes as in y and z;
+    // one line at a time it is a chain of dependent scalar operations.
+    constexpr int kLines = 8;
+    std::vector<float> lines(static_cast<std::size_t>(nx) * kLines);
 #pragma omp for schedule(static)
     for (int k = 0; k < nz; ++k)
-      for (int j = 0; j < ny; ++j) prefilter_line(values.data() + j * sy + k * sz, nx);
+      for (int j0 = 0; j0 < ny; j0 += kLines) {
+        const int width = std::min(kLines, ny - j0);
+        float* slice = values.data() + k * sz + j0 * sy;
+        for (int l = 0; l < width; ++l)
+          for (int i = 0; i < nx; ++i) lines[static_cast<std::size_t>(i) * kLines + l] = slice[l * sy + i];
+        prefilter_rows(lines.data(), kLines, nx, width);
+        for (int l = 0; l < width; ++l)
+          for (int i = 0; i < nx; ++i) slice[l * sy + i] = lines[static_cast<std::size_t>(i) * kLines + l];
+      }
     // y and z: all lines of a slice (or of an x-z sheet) advance together, row by row, so the
     // inner loop runs over contiguous x (vectorised, no strided gathers).
 #pragma omp for schedule(static)
