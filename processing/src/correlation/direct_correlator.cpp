@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstring>
 
 #include "tomorig/processing/correlation/peak_fit.h"
 
@@ -35,15 +34,6 @@ struct WindowSums {
 };
 
 inline int lag_index(int dx, int dy, int dz) { return (dx + 1) + 3 * ((dy + 1) + 3 * (dz + 1)); }
-
-// Four float lanes (GCC/Clang vector extension): the x lags -1, 0, 1 (and a 4th of weight 0)
-// of a row of the 3 x 3 x 3 neighbourhood, summed in registers.
-using Lanes = float __attribute__((vector_size(16)));
-inline Lanes load_lanes(const float* p) {
-  Lanes r;
-  std::memcpy(&r, p, sizeof r);
-  return r;
-}
 
 }  // namespace
 
@@ -147,11 +137,9 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
     s.a_j.push_back(static_cast<std::uint16_t>(j));
     s.a_k.push_back(static_cast<std::uint16_t>(k));
   });
-  // Window b: its sums, and QB(s) = sum_y w(y) B(y) w(y - s) at the 27 lags: the entries'
-  // factors gathered first, then summed with the 9 rows' lanes in registers.
-  s.lanes.clear();
-  s.ly.clear();
-  s.lz.clear();
+  // Window b: its sums, and QB(s) = sum_y w(y) B(y) w(y - s) at the 27 lags.
+  double qb[27] = {};
+  alignas(16) float qb4[9][4] = {};  // per (dy, dz) row, x lags as 4 float lanes (the 4th unused)
   for_window_entries(ob, [&](int i, int j, int k, float value) {
     const float weight = wx_[i] * wy_[j] * wz_[k];
     const double w2 = static_cast<double>(weight) * weight;
@@ -159,35 +147,23 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
     sb.weighted += w2 * value;
     sb.weighted_square += w2 * value * value;
     const float wb = weight * value;
+    float py[3], pz[3];
+    alignas(16) float px[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     for (int d = -1; d <= 1; ++d) {
-      s.lanes.push_back(wx_[wrap(i - d, w.x)]);
-      s.ly.push_back(wy_[wrap(j - d, w.y)]);
-      s.lz.push_back(wb * wz_[wrap(k - d, w.z)]);
+      px[d + 1] = wx_[wrap(i - d, w.x)];
+      py[d + 1] = wy_[wrap(j - d, w.y)];
+      pz[d + 1] = wz_[wrap(k - d, w.z)];
     }
-    s.lanes.push_back(0.0f);
+    for (int dz = 0; dz < 3; ++dz)
+      for (int dy = 0; dy < 3; ++dy) {
+        const float f = wb * pz[dz] * py[dy];
+        float* q = qb4[dy + 3 * dz];
+#pragma omp simd
+        for (int l = 0; l < 4; ++l) q[l] += f * px[l];
+      }
   });
-  double qb[27] = {};
-  {
-    Lanes q[9] = {};
-    const std::size_t entries = s.ly.size() / 3;
-    const float* lanes = s.lanes.data();
-    const float* ly = s.ly.data();
-    const float* lz = s.lz.data();
-    for (std::size_t e = 0; e < entries; ++e, lanes += 4, ly += 3, lz += 3) {
-      const Lanes x = load_lanes(lanes);
-      q[0] += x * (lz[0] * ly[0]);
-      q[1] += x * (lz[0] * ly[1]);
-      q[2] += x * (lz[0] * ly[2]);
-      q[3] += x * (lz[1] * ly[0]);
-      q[4] += x * (lz[1] * ly[1]);
-      q[5] += x * (lz[1] * ly[2]);
-      q[6] += x * (lz[2] * ly[0]);
-      q[7] += x * (lz[2] * ly[1]);
-      q[8] += x * (lz[2] * ly[2]);
-    }
-    for (int r = 0; r < 9; ++r)
-      for (int l = 0; l < 3; ++l) qb[3 * r + l] = q[r][l];
-  }
+  for (int r = 0; r < 9; ++r)
+    for (int l = 0; l < 3; ++l) qb[3 * r + l] = qb4[r][l];
   const double mean_a = sa.sum / n, mean_b = sb.sum / n;
   // sum w^2 (A - mean)^2 over the whole window, the empty voxels included.
   const double energy_a = sa.weighted_square - 2 * mean_a * sa.weighted + mean_a * mean_a * weight_energy_;
@@ -212,10 +188,6 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
   const std::size_t sy = static_cast<std::size_t>(vb.nx), sz = sy * static_cast<std::size_t>(vb.ny);
   const bool inside = start.x >= 0 && start.y >= 0 && start.z >= 0 && start.x + w.x <= vb.nx &&
                       start.y + w.y <= vb.ny && start.z + w.z <= vb.nz;
-  s.lanes.clear();
-  s.ly.clear();
-  s.lz.clear();
-  s.centre.clear();
   for (std::size_t e = 0; e < count; ++e) {
     const int i = s.a_i[e], j = s.a_j[e], k = s.a_k[e];
     const float wa = s.a_weight[e];
@@ -226,16 +198,24 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
       pz[d + 1] = wz_[wrap(k + d, w.z)];
     }
     // Interior: no wrap, no bounds, and the row's fourth value (weight 0) is inside the volume.
-    // Its factors are kept for the vectorised sums below.
     const bool interior = inside && i >= 1 && j >= 1 && k >= 1 && i + 2 < w.x && j + 1 < w.y && k + 1 < w.z;
     if (interior) {
-      s.centre.push_back(static_cast<std::ptrdiff_t>(vb.linear(start.x + i, start.y + j, start.z + k)));
-      for (int d = 0; d < 3; ++d) {
-        s.lanes.push_back(px[d]);
-        s.ly.push_back(py[d]);
-        s.lz.push_back(wa * pz[d]);
-      }
-      s.lanes.push_back(0.0f);
+      // The 3 x 3 x 3 neighbourhood straight from the volume, x lags as 4 float lanes.
+      const float* centre = vb.data + vb.linear(start.x + i, start.y + j, start.z + k);
+      const float lanes[4] = {px[0], px[1], px[2], 0.0f};
+      for (int dz = 0; dz < 3; ++dz)
+        for (int dy = 0; dy < 3; ++dy) {
+          const float f = wa * pz[dz] * py[dy];
+          const float* row = centre + (dz - 1) * sz + (dy - 1) * sy - 1;
+          float* pr = p4[dy + 3 * dz];
+          float* qr = qa4[dy + 3 * dz];
+#pragma omp simd
+          for (int l = 0; l < 4; ++l) {
+            const float g = f * lanes[l];
+            pr[l] += g * row[l];
+            qr[l] += g;
+          }
+        }
       continue;
     }
     // Edge of the window: the lags wrap around it (as the FFT's). Each axis's three wrapped
@@ -264,38 +244,6 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
           ql[dx] += f;
         }
       }
-  }
-  // The interior entries, one z lag at a time: 3 rows of P and QA (6 lane sums) in registers.
-  // (f = wA pz py and g = f px in the same order as the edge path's, the entries in the same
-  // order: the sums do not depend on how they were split.)
-  {
-    const std::size_t entries = s.centre.size();
-    for (int dz = 0; dz < 3; ++dz) {
-      Lanes p0 = {}, p1 = {}, p2 = {}, q0 = {}, q1 = {}, q2 = {};
-      const std::ptrdiff_t shift = (dz - 1) * static_cast<std::ptrdiff_t>(sz) - 1;
-      const std::ptrdiff_t row_y = static_cast<std::ptrdiff_t>(sy);
-      for (std::size_t e = 0; e < entries; ++e) {
-        const float* c = vb.data + s.centre[e] + shift;
-        const Lanes x = load_lanes(s.lanes.data() + 4 * e);
-        const float fz = s.lz[3 * e + dz];
-        const float* py = s.ly.data() + 3 * e;
-        const Lanes g0 = x * (fz * py[0]), g1 = x * (fz * py[1]), g2 = x * (fz * py[2]);
-        q0 += g0;
-        q1 += g1;
-        q2 += g2;
-        p0 += g0 * load_lanes(c - row_y);
-        p1 += g1 * load_lanes(c);
-        p2 += g2 * load_lanes(c + row_y);
-      }
-      for (int l = 0; l < 4; ++l) {
-        p4[3 * dz][l] = p0[l];
-        p4[3 * dz + 1][l] = p1[l];
-        p4[3 * dz + 2][l] = p2[l];
-        qa4[3 * dz][l] = q0[l];
-        qa4[3 * dz + 1][l] = q1[l];
-        qa4[3 * dz + 2][l] = q2[l];
-      }
-    }
   }
   for (int r = 0; r < 9; ++r)
     for (int l = 0; l < 3; ++l) {

@@ -41,11 +41,6 @@ class DirectCorrelator {
   struct Scratch {
     std::vector<float> a_weight;     // w(x) A(x) of the window's entries of a
     std::vector<std::uint16_t> a_i, a_j, a_k;  // their window coordinates
-    // Per-entry factors of the vectorised sums: the 4 x-lag weights (the 4th 0), and the
-    // y- and z-lag weights (of a: z pre-multiplied by w A, its interior entries only; of b:
-    // y pre-multiplied by w B). `centre`: a's interior entries' voxel index in b's volume.
-    std::vector<float> lanes, ly, lz;
-    std::vector<std::ptrdiff_t> centre;
     StageSeconds seconds;
   };
 
