@@ -90,6 +90,15 @@ DirectCorrelator::DirectCorrelator(Int3 window, WindowWeighting weighting, doubl
   for (float w : wy_) ey += static_cast<double>(w) * w;
   for (float w : wz_) ez += static_cast<double>(w) * w;
   weight_energy_ = ex * ey * ez;
+  auto padded = [](const std::vector<float>& w) {
+    const int n = static_cast<int>(w.size());
+    std::vector<float> p(n + 4);
+    for (int i = -2; i < n + 2; ++i) p[i + 2] = w[((i % n) + n) % n];
+    return p;
+  };
+  px_ = padded(wx_);
+  py_ = padded(wy_);
+  pz_ = padded(wz_);
   weight_autocorrelation(wx_, kx_);
   weight_autocorrelation(wy_, ky_);
   weight_autocorrelation(wz_, kz_);
@@ -111,10 +120,15 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
       for (int by = by0; by <= by1; ++by)
         for (int bx = bx0; bx <= bx1; ++bx) {
           const std::size_t b = bx + static_cast<std::size_t>(o.blocks.x) * (by + static_cast<std::size_t>(o.blocks.y) * bz);
+          // A block wholly inside the window (every block when windows start on the block
+          // grid, as the passes' do) needs no test per entry.
+          const bool whole = bx * o.block.x >= start.x && (bx + 1) * o.block.x <= start.x + w.x &&
+                             by * o.block.y >= start.y && (by + 1) * o.block.y <= start.y + w.y &&
+                             bz * o.block.z >= start.z && (bz + 1) * o.block.z <= start.z + w.z;
           for (std::size_t e = o.offsets[b]; e < o.offsets[b + 1]; ++e) {
             const OccupiedVoxels::Entry& v = o.entries[e];
             const int i = v.x - start.x, j = v.y - start.y, k = v.z - start.z;
-            if (i < 0 || j < 0 || k < 0 || i >= w.x || j >= w.y || k >= w.z) continue;
+            if (!whole && (i < 0 || j < 0 || k < 0 || i >= w.x || j >= w.y || k >= w.z)) continue;
             f(i, j, k, v.value);
           }
         }
@@ -150,9 +164,9 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
     float py[3], pz[3];
     alignas(16) float px[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     for (int d = -1; d <= 1; ++d) {
-      px[d + 1] = wx_[wrap(i - d, w.x)];
-      py[d + 1] = wy_[wrap(j - d, w.y)];
-      pz[d + 1] = wz_[wrap(k - d, w.z)];
+      px[d + 1] = px_[i - d + 2];
+      py[d + 1] = py_[j - d + 2];
+      pz[d + 1] = pz_[k - d + 2];
     }
     for (int dz = 0; dz < 3; ++dz)
       for (int dy = 0; dy < 3; ++dy) {
@@ -193,9 +207,9 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
     const float wa = s.a_weight[e];
     float px[3], py[3], pz[3];
     for (int d = -1; d <= 1; ++d) {
-      px[d + 1] = wx_[wrap(i + d, w.x)];
-      py[d + 1] = wy_[wrap(j + d, w.y)];
-      pz[d + 1] = wz_[wrap(k + d, w.z)];
+      px[d + 1] = px_[i + d + 2];
+      py[d + 1] = py_[j + d + 2];
+      pz[d + 1] = pz_[k + d + 2];
     }
     // Interior: no wrap, no bounds, and the row's fourth value (weight 0) is inside the volume.
     const bool interior = inside && i >= 1 && j >= 1 && k >= 1 && i + 2 < w.x && j + 1 < w.y && k + 1 < w.z;
