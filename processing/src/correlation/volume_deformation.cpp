@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace tomorig::piv::detail {
 namespace {
@@ -365,6 +366,7 @@ void deform_row(const VolumeView& v, const std::uint8_t* support, Interpolation 
                 float sign, const float* hx, const float* hy, const float* hz, RowScratch& s, float* out) {
   const std::size_t sy = static_cast<std::size_t>(v.nx), sz = sy * static_cast<std::size_t>(v.ny);
   const int n = v.nx;
+  if (n <= 0) return;
   float* xs = s.x.data();
   float* ys = s.y.data();
   float* zs = s.z.data();
@@ -380,19 +382,29 @@ void deform_row(const VolumeView& v, const std::uint8_t* support, Interpolation 
     // The voxel nearest to each source position, clamped into the volume (outside it the sample
     // is 0 anyway except within half a voxel, which the clamp keeps): clamped in float, so the
     // truncation is the floor, and vectorised.
-    int* nearest = s.nearest.data();
     const float top_x = v.nx - 0.5f, top_y = v.ny - 0.5f, top_z = v.nz - 0.5f;
-    const int row_y = v.nx, slice = v.nx * v.ny;  // the volume has < 2^31 voxels (int offsets)
+    if (v.count() <= static_cast<std::size_t>(std::numeric_limits<int>::max())) {
+      int* nearest = s.nearest.data();
+      const int row_y = v.nx, slice = v.nx * v.ny;  // int offsets: the volume has < 2^31 voxels
 #pragma omp simd
-    for (int i = 0; i < n; ++i) {
-      const int si = static_cast<int>(std::min(std::max(xs[i] + 0.5f, 0.0f), top_x));
-      const int sj = static_cast<int>(std::min(std::max(ys[i] + 0.5f, 0.0f), top_y));
-      const int sk = static_cast<int>(std::min(std::max(zs[i] + 0.5f, 0.0f), top_z));
-      nearest[i] = si + row_y * sj + slice * sk;
-    }
-    for (int i = 0; i < n; ++i) {
-      kept[count] = i;
-      count += support[nearest[i]] != 0;
+      for (int i = 0; i < n; ++i) {
+        const int si = static_cast<int>(std::min(std::max(xs[i] + 0.5f, 0.0f), top_x));
+        const int sj = static_cast<int>(std::min(std::max(ys[i] + 0.5f, 0.0f), top_y));
+        const int sk = static_cast<int>(std::min(std::max(zs[i] + 0.5f, 0.0f), top_z));
+        nearest[i] = si + row_y * sj + slice * sk;
+      }
+      for (int i = 0; i < n; ++i) {
+        kept[count] = i;
+        count += support[nearest[i]] != 0;
+      }
+    } else {  // a larger volume: the same with 64-bit offsets, not vectorised
+      for (int i = 0; i < n; ++i) {
+        const int si = static_cast<int>(std::min(std::max(xs[i] + 0.5f, 0.0f), top_x));
+        const int sj = static_cast<int>(std::min(std::max(ys[i] + 0.5f, 0.0f), top_y));
+        const int sk = static_cast<int>(std::min(std::max(zs[i] + 0.5f, 0.0f), top_z));
+        kept[count] = i;
+        count += support[v.linear(si, sj, sk)] != 0;
+      }
     }
     std::fill(out, out + n, 0.0f);
   } else {
