@@ -23,15 +23,32 @@ namespace {
 using detail::Int3;
 using detail::VolumeView;
 
-// The pair of volumes at one binning factor, with B-spline coefficients made on demand.
+// The pair of volumes at one binning factor, with B-spline coefficients and support masks made
+// on demand (once per correlation, reused by every pass at this factor).
 struct Level {
-  std::vector<float> a, b;              // binned samples (empty for factor 1: the inputs are used)
-  VolumeView view_a, view_b;
-  std::vector<float> coef_a, coef_b;    // cubic B-spline coefficients, empty until needed
+  std::vector<float> a, b;              // binned samples (unused for factor 1: the inputs are used)
+  VolumeView view_a, view_b;            // data null: not made yet in this correlation
+  bool prefiltered = false, supported = false;
+  std::vector<float> coef_a, coef_b;    // cubic B-spline coefficients, valid if prefiltered
   std::vector<float> deformed_a, deformed_b;
-  std::vector<std::uint8_t> support_a, support_b;  // signal_support of a and b, empty until needed
+  std::vector<std::uint8_t> support_a, support_b;  // signal_support of a and b, valid if supported
+  std::vector<std::uint8_t> support_scratch;
   detail::OccupiedVoxels occupied_a, occupied_b;   // of the deformed pair, memory reused by each pass
 };
+
+// The buffers of a correlation, kept by the calling thread from one correlation to the next
+// (the back-end correlates every set of a run on the same thread): hundreds of megabytes of
+// coefficients, deformed volumes and masks are allocated, and their pages faulted in and
+// zeroed by the kernel, once per run instead of once per set. Only the memory is kept; every
+// correlation recomputes its contents.
+std::map<int, Level>& thread_levels() {
+  thread_local std::map<int, Level> levels;
+  for (auto& [factor, level] : levels) {
+    level.view_a = level.view_b = {};
+    level.prefiltered = level.supported = false;
+  }
+  return levels;
+}
 
 // Where the windows of a pass sit, in voxels of its (binned) level.
 struct PassGeometry {
@@ -98,7 +115,7 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
   const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
   report = {};
 
-  std::map<int, Level> levels;
+  std::map<int, Level>& levels = thread_levels();
   auto level_for = [&](int factor) -> Level& {
     Level& level = levels[factor];
     if (level.view_a.data) return level;
@@ -108,8 +125,8 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
       level.view_a = full_a;
       level.view_b = full_b;
     } else {
-      level.a = detail::downsample_sum(full_a, factor, threads);
-      level.b = detail::downsample_sum(full_b, factor, threads);
+      detail::downsample_sum(full_a, factor, threads, level.a);
+      detail::downsample_sum(full_b, factor, threads, level.b);
       level.view_a = {level.a.data(), a.grid.nx / factor, a.grid.ny / factor, a.grid.nz / factor};
       level.view_b = {level.b.data(), a.grid.nx / factor, a.grid.ny / factor, a.grid.nz / factor};
     }
@@ -130,19 +147,23 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
     VolumeView va = level.view_a, vb = level.view_b;
     if (deform) {
       if (pass.interpolation == Interpolation::cubic_bspline) {
-        if (level.coef_a.empty()) {
+        if (!level.prefiltered) {
           level.coef_a.assign(level.view_a.data, level.view_a.data + level.view_a.count());
           level.coef_b.assign(level.view_b.data, level.view_b.data + level.view_b.count());
           detail::bspline_prefilter(level.coef_a, va.nx, va.ny, va.nz, threads);
           detail::bspline_prefilter(level.coef_b, vb.nx, vb.ny, vb.nz, threads);
+          level.prefiltered = true;
         }
         va.data = level.coef_a.data();
         vb.data = level.coef_b.data();
       }
       // Where the samples have signal: made once per level, reused by every deformation pass.
-      if (level.support_a.empty()) {
-        level.support_a = detail::signal_support(level.view_a, detail::kOccupiedThreshold, detail::kSupportRadius, threads);
-        level.support_b = detail::signal_support(level.view_b, detail::kOccupiedThreshold, detail::kSupportRadius, threads);
+      if (!level.supported) {
+        detail::signal_support(level.view_a, detail::kOccupiedThreshold, detail::kSupportRadius, threads,
+                               level.support_a, level.support_scratch);
+        detail::signal_support(level.view_b, detail::kOccupiedThreshold, detail::kSupportRadius, threads,
+                               level.support_b, level.support_scratch);
+        level.supported = true;
       }
       detail::deform_pair(va, vb, predictor, g.factor, pass.interpolation, level.deformed_a, level.deformed_b, threads,
                           level.support_a, level.support_b);

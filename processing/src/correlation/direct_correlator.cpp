@@ -90,6 +90,15 @@ DirectCorrelator::DirectCorrelator(Int3 window, WindowWeighting weighting, doubl
   for (float w : wy_) ey += static_cast<double>(w) * w;
   for (float w : wz_) ez += static_cast<double>(w) * w;
   weight_energy_ = ex * ey * ez;
+  auto padded = [](const std::vector<float>& w) {
+    const int n = static_cast<int>(w.size());
+    std::vector<float> p(n + 4);
+    for (int i = -2; i < n + 2; ++i) p[i + 2] = w[((i % n) + n) % n];
+    return p;
+  };
+  px_ = padded(wx_);
+  py_ = padded(wy_);
+  pz_ = padded(wz_);
   weight_autocorrelation(wx_, kx_);
   weight_autocorrelation(wy_, ky_);
   weight_autocorrelation(wz_, kz_);
@@ -111,10 +120,15 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
       for (int by = by0; by <= by1; ++by)
         for (int bx = bx0; bx <= bx1; ++bx) {
           const std::size_t b = bx + static_cast<std::size_t>(o.blocks.x) * (by + static_cast<std::size_t>(o.blocks.y) * bz);
+          // A block wholly inside the window (every block when windows start on the block
+          // grid, as the passes' do) needs no test per entry.
+          const bool whole = bx * o.block.x >= start.x && (bx + 1) * o.block.x <= start.x + w.x &&
+                             by * o.block.y >= start.y && (by + 1) * o.block.y <= start.y + w.y &&
+                             bz * o.block.z >= start.z && (bz + 1) * o.block.z <= start.z + w.z;
           for (std::size_t e = o.offsets[b]; e < o.offsets[b + 1]; ++e) {
             const OccupiedVoxels::Entry& v = o.entries[e];
             const int i = v.x - start.x, j = v.y - start.y, k = v.z - start.z;
-            if (i < 0 || j < 0 || k < 0 || i >= w.x || j >= w.y || k >= w.z) continue;
+            if (!whole && (i < 0 || j < 0 || k < 0 || i >= w.x || j >= w.y || k >= w.z)) continue;
             f(i, j, k, v.value);
           }
         }
@@ -139,6 +153,7 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
   });
   // Window b: its sums, and QB(s) = sum_y w(y) B(y) w(y - s) at the 27 lags.
   double qb[27] = {};
+  alignas(16) float qb4[9][4] = {};  // per (dy, dz) row, x lags as 4 float lanes (the 4th unused)
   for_window_entries(ob, [&](int i, int j, int k, float value) {
     const float weight = wx_[i] * wy_[j] * wz_[k];
     const double w2 = static_cast<double>(weight) * weight;
@@ -146,21 +161,23 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
     sb.weighted += w2 * value;
     sb.weighted_square += w2 * value * value;
     const float wb = weight * value;
-    float px[3], py[3], pz[3];
+    float py[3], pz[3];
+    alignas(16) float px[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     for (int d = -1; d <= 1; ++d) {
-      px[d + 1] = wx_[wrap(i - d, w.x)];
-      py[d + 1] = wy_[wrap(j - d, w.y)];
-      pz[d + 1] = wz_[wrap(k - d, w.z)];
+      px[d + 1] = px_[i - d + 2];
+      py[d + 1] = py_[j - d + 2];
+      pz[d + 1] = pz_[k - d + 2];
     }
     for (int dz = 0; dz < 3; ++dz)
       for (int dy = 0; dy < 3; ++dy) {
         const float f = wb * pz[dz] * py[dy];
-        double* q = qb + 3 * (dy + 3 * dz);
-        q[0] += f * px[0];
-        q[1] += f * px[1];
-        q[2] += f * px[2];
+        float* q = qb4[dy + 3 * dz];
+#pragma omp simd
+        for (int l = 0; l < 4; ++l) q[l] += f * px[l];
       }
   });
+  for (int r = 0; r < 9; ++r)
+    for (int l = 0; l < 3; ++l) qb[3 * r + l] = qb4[r][l];
   const double mean_a = sa.sum / n, mean_b = sb.sum / n;
   // sum w^2 (A - mean)^2 over the whole window, the empty voxels included.
   const double energy_a = sa.weighted_square - 2 * mean_a * sa.weighted + mean_a * mean_a * weight_energy_;
@@ -190,9 +207,9 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
     const float wa = s.a_weight[e];
     float px[3], py[3], pz[3];
     for (int d = -1; d <= 1; ++d) {
-      px[d + 1] = wx_[wrap(i + d, w.x)];
-      py[d + 1] = wy_[wrap(j + d, w.y)];
-      pz[d + 1] = wz_[wrap(k + d, w.z)];
+      px[d + 1] = px_[i + d + 2];
+      py[d + 1] = py_[j + d + 2];
+      pz[d + 1] = pz_[k + d + 2];
     }
     // Interior: no wrap, no bounds, and the row's fourth value (weight 0) is inside the volume.
     const bool interior = inside && i >= 1 && j >= 1 && k >= 1 && i + 2 < w.x && j + 1 < w.y && k + 1 < w.z;
@@ -215,14 +232,32 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
         }
       continue;
     }
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const float f = wa * pz[dz + 1] * py[dy + 1] * px[dx + 1];
-          const int l = lag_index(dx, dy, dz);
-          p[l] += f * b_at(wrap(i + dx, w.x), wrap(j + dy, w.y), wrap(k + dz, w.z));
-          qa[l] += f;
+    // Edge of the window: the lags wrap around it (as the FFT's). Each axis's three wrapped
+    // coordinates are looked up once; a coordinate outside the volume reads 0.
+    std::ptrdiff_t ox[3], oy[3], oz[3];
+    bool in_x[3], in_y[3], in_z[3];
+    for (int d = -1; d <= 1; ++d) {
+      const int x = start.x + wrap(i + d, w.x), y = start.y + wrap(j + d, w.y), z = start.z + wrap(k + d, w.z);
+      in_x[d + 1] = x >= 0 && x < vb.nx;
+      in_y[d + 1] = y >= 0 && y < vb.ny;
+      in_z[d + 1] = z >= 0 && z < vb.nz;
+      ox[d + 1] = x;
+      oy[d + 1] = static_cast<std::ptrdiff_t>(y) * static_cast<std::ptrdiff_t>(sy);
+      oz[d + 1] = static_cast<std::ptrdiff_t>(z) * static_cast<std::ptrdiff_t>(sz);
+    }
+    for (int dz = 0; dz < 3; ++dz)
+      for (int dy = 0; dy < 3; ++dy) {
+        const float fzy = wa * pz[dz] * py[dy];
+        const bool row_in = in_z[dz] && in_y[dy];
+        const float* row = vb.data + (row_in ? oz[dz] + oy[dy] : 0);
+        double* pl = p + 3 * (dy + 3 * dz);
+        double* ql = qa + 3 * (dy + 3 * dz);
+        for (int dx = 0; dx < 3; ++dx) {
+          const float f = fzy * px[dx];
+          pl[dx] += f * (row_in && in_x[dx] ? row[ox[dx]] : 0.0f);
+          ql[dx] += f;
         }
+      }
   }
   for (int r = 0; r < 9; ++r)
     for (int l = 0; l < 3; ++l) {

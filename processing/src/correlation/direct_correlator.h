@@ -53,6 +53,9 @@ class DirectCorrelator {
  private:
   Int3 window_;
   std::vector<float> wx_, wy_, wz_;      // separable weights per axis
+  // The same, circularly padded by 2 on both sides (element i + 2 is the weight at i, for
+  // i = -2 .. n + 1): the lags' weights without a wrap test per lag.
+  std::vector<float> px_, py_, pz_;
   double weight_energy_ = 0;             // sum of w^2 over the window
   // Circular autocorrelation of the weights per axis, K(d) for d = -2..2 at index d + 2.
   double kx_[5], ky_[5], kz_[5];

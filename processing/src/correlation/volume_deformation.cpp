@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace tomorig::piv::detail {
 namespace {
@@ -19,23 +20,8 @@ inline int floor_int(float x) {
   return t - (x < static_cast<float>(t));
 }
 
-// One line of the recursive cubic B-spline prefilter (pole sqrt(3) - 2, mirror boundaries).
-void prefilter_line(float* c, int n) {
-  if (n < 2) return;
-  constexpr double pole = -0.2679491924311228;  // sqrt(3) - 2
-  constexpr double gain = 6.0;                  // (1 - pole)(1 - 1 / pole)
-  for (int k = 0; k < n; ++k) c[k] = static_cast<float>(c[k] * gain);
-  // Causal initialisation: the mirrored sum, truncated where pole^k is negligible.
-  const int horizon = std::min(n, 30);
-  double sum = c[0], zk = pole;
-  for (int k = 1; k < horizon; ++k, zk *= pole) sum += zk * c[k];
-  c[0] = static_cast<float>(sum);
-  for (int k = 1; k < n; ++k) c[k] = static_cast<float>(c[k] + pole * c[k - 1]);
-  c[n - 1] = static_cast<float>(pole / (pole * pole - 1.0) * (c[n - 1] + pole * c[n - 2]));
-  for (int k = n - 2; k >= 0; --k) c[k] = static_cast<float>(pole * (c[k + 1] - c[k]));
-}
-
-// prefilter_line on `width` lines at once: element k of every line is the contiguous row
+// The recursive cubic B-spline prefilter (pole sqrt(3) - 2, mirror boundaries) on `width`
+// lines of n elements at once: element k of every line is the contiguous row
 // base[k * stride .. k * stride + width).
 void prefilter_rows(float* base, std::size_t stride, int n, int width) {
   if (n < 2) return;
@@ -100,10 +86,11 @@ float sample_trilinear(const VolumeView& v, float x, float y, float z) {
 
 void bspline_weights(float t, float w[4]) {
   const float t2 = t * t, t3 = t2 * t, u = 1.0f - t;
-  w[0] = u * u * u / 6.0f;
-  w[1] = (4.0f - 6.0f * t2 + 3.0f * t3) / 6.0f;
-  w[2] = (1.0f + 3.0f * t + 3.0f * t2 - 3.0f * t3) / 6.0f;
-  w[3] = t3 / 6.0f;
+  constexpr float sixth = 1.0f / 6.0f;  // a multiply: a division by 6 costs as much as the taps
+  w[0] = u * u * u * sixth;
+  w[1] = (4.0f - 6.0f * t2 + 3.0f * t3) * sixth;
+  w[2] = (1.0f + 3.0f * t + 3.0f * t2 - 3.0f * t3) * sixth;
+  w[3] = t3 * sixth;
 }
 
 int mirror(int i, int n) {
@@ -148,16 +135,6 @@ float sample_bspline(const VolumeView& c, float x, float y, float z) {
   return result;
 }
 
-// Whether the support mask (empty: everywhere) marks the voxel nearest to (x, y, z); outside
-// the volume the sample is 0 anyway except within half a voxel, which the clamp keeps.
-bool has_signal(const std::vector<std::uint8_t>& support, const VolumeView& v, float x, float y, float z) {
-  if (support.empty()) return true;
-  const int i = std::clamp(floor_int(x + 0.5f), 0, v.nx - 1);
-  const int j = std::clamp(floor_int(y + 0.5f), 0, v.ny - 1);
-  const int k = std::clamp(floor_int(z + 0.5f), 0, v.nz - 1);
-  return support[v.linear(i, j, k)] != 0;
-}
-
 }  // namespace
 
 void locate_axis(double p, double origin, double spacing, int n, int& i0, double& frac) {
@@ -170,9 +147,9 @@ void locate_axis(double p, double origin, double spacing, int n, int& i0, double
   frac = n > 1 ? u - i0 : 0.0;
 }
 
-std::vector<float> downsample_sum(const VolumeView& v, int factor, int threads) {
+void downsample_sum(const VolumeView& v, int factor, int threads, std::vector<float>& out) {
   const int nx = v.nx / factor, ny = v.ny / factor, nz = v.nz / factor;
-  std::vector<float> out(static_cast<std::size_t>(nx) * ny * nz, 0.0f);
+  out.assign(static_cast<std::size_t>(nx) * ny * nz, 0.0f);
 #pragma omp parallel for num_threads(thread_count(threads)) schedule(static)
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < ny; ++j) {
@@ -184,7 +161,6 @@ std::vector<float> downsample_sum(const VolumeView& v, int factor, int threads) 
             for (int di = 0; di < factor; ++di) dst[i] += src[i * factor + di];
         }
     }
-  return out;
 }
 
 void bspline_prefilter(std::vector<float>& values, int nx, int ny, int nz, int threads) {
@@ -193,10 +169,22 @@ void bspline_prefilter(std::vector<float>& values, int nx, int ny, int nz, int t
 #pragma omp parallel num_threads(t)
   {
     const FlushDenormals flush;
-    // x: contiguous lines, one at a time.
+    // x: kLines lines at a time, transposed into a small buffer (element k of every line one
+    // contiguous row) so that the recursion runs over the lines in float lanes as in y and z;
+    // one line at a time it is a chain of dependent scalar operations.
+    constexpr int kLines = 8;
+    std::vector<float> lines(static_cast<std::size_t>(nx) * kLines);
 #pragma omp for schedule(static)
     for (int k = 0; k < nz; ++k)
-      for (int j = 0; j < ny; ++j) prefilter_line(values.data() + j * sy + k * sz, nx);
+      for (int j0 = 0; j0 < ny; j0 += kLines) {
+        const int width = std::min(kLines, ny - j0);
+        float* slice = values.data() + k * sz + j0 * sy;
+        for (int l = 0; l < width; ++l)
+          for (int i = 0; i < nx; ++i) lines[static_cast<std::size_t>(i) * kLines + l] = slice[l * sy + i];
+        prefilter_rows(lines.data(), kLines, nx, width);
+        for (int l = 0; l < width; ++l)
+          for (int i = 0; i < nx; ++i) slice[l * sy + i] = lines[static_cast<std::size_t>(i) * kLines + l];
+      }
     // y and z: all lines of a slice (or of an x-z sheet) advance together, row by row, so the
     // inner loop runs over contiguous x (vectorised, no strided gathers).
 #pragma omp for schedule(static)
@@ -271,14 +259,19 @@ Vec3f RowPredictor::at(double x) const {
   return {static_cast<float>(r[0]), static_cast<float>(r[1]), static_cast<float>(r[2])};
 }
 
-std::vector<std::uint8_t> signal_support(const VolumeView& v, float relative_threshold, int radius, int threads) {
+void signal_support(const VolumeView& v, float relative_threshold, int radius, int threads, std::vector<std::uint8_t>& out,
+                    std::vector<std::uint8_t>& scratch) {
   const int t = thread_count(threads);
   const std::size_t count = v.count();
   float largest = 0.0f;
 #pragma omp parallel for num_threads(t) reduction(max : largest) schedule(static)
   for (long long n = 0; n < static_cast<long long>(count); ++n) largest = std::max(largest, std::abs(v.data[n]));
   const float threshold = relative_threshold * largest;
-  std::vector<std::uint8_t> mask(count), spread(count);
+  // Every byte of both is written below before it is read.
+  std::vector<std::uint8_t>& mask = scratch;
+  std::vector<std::uint8_t>& spread = out;
+  mask.resize(count);
+  spread.resize(count);
   // Dilation by `radius` as three separable maxima (x, then y, then z) of width 2 radius + 1.
   const std::size_t sy = v.nx, sz = static_cast<std::size_t>(v.nx) * v.ny;
 #pragma omp parallel num_threads(t)
@@ -319,8 +312,126 @@ std::vector<std::uint8_t> signal_support(const VolumeView& v, float relative_thr
       }
     }
   }
-  return spread;
 }
+
+namespace {
+
+// The predictor's x-interpolation is the same on every row: each voxel's cell (left node) and
+// fraction, found once per deformation instead of per voxel (locate_axis in double).
+struct AxisCells {
+  std::vector<int> cell;
+  std::vector<float> frac;
+};
+
+AxisCells axis_cells(int voxels, int factor, double offset, double origin, double spacing, int nodes) {
+  AxisCells c;
+  c.cell.resize(voxels);
+  c.frac.resize(voxels);
+  for (int i = 0; i < voxels; ++i) {
+    double frac;
+    locate_axis(i * factor + offset, origin, spacing, nodes, c.cell[i], frac);
+    c.frac[i] = static_cast<float>(frac);
+  }
+  return c;
+}
+
+// The 4 x 4 x 4 B-spline sum of an interior sample: the 16 rows of 4 coefficients weighted by
+// wz * wy into 4 lanes, then the lanes by wx (two packed multiply-adds per row).
+inline float bspline_interior(const float* base, std::size_t sy, std::size_t sz, const float wx[4], const float wy[4],
+                              const float wz[4]) {
+  float acc[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  for (int dk = 0; dk < 4; ++dk)
+    for (int dj = 0; dj < 4; ++dj) {
+      const float w = wz[dk] * wy[dj];
+      const float* row = base + dk * sz + dj * sy;
+#pragma omp simd
+      for (int l = 0; l < 4; ++l) acc[l] += w * row[l];
+    }
+  return (wx[0] * acc[0] + wx[1] * acc[1]) + (wx[2] * acc[2] + wx[3] * acc[3]);
+}
+
+// Per-thread buffers of deform_row, sized once per thread.
+struct RowScratch {
+  std::vector<float> x, y, z;  // source positions of the row's voxels
+  std::vector<int> nearest;    // linear index of the voxel nearest to each source position
+  std::vector<int> kept;       // the voxels whose source has signal
+  explicit RowScratch(int n) : x(n), y(n), z(n), nearest(n), kept(n) {}
+};
+
+// One deformed row: out[i] = v(i + sign * h(i), j + ..., k + ...), 0 where the support (if any)
+// says the source has no signal. The support test runs without branches over the whole row
+// and lists the voxels to interpolate (a mask of irregular particle images mispredicts any
+// per-voxel branch); only those are evaluated.
+void deform_row(const VolumeView& v, const std::uint8_t* support, Interpolation interpolation, int j, int k,
+                float sign, const float* hx, const float* hy, const float* hz, RowScratch& s, float* out) {
+  const std::size_t sy = static_cast<std::size_t>(v.nx), sz = sy * static_cast<std::size_t>(v.ny);
+  const int n = v.nx;
+  if (n <= 0) return;
+  float* xs = s.x.data();
+  float* ys = s.y.data();
+  float* zs = s.z.data();
+#pragma omp simd
+  for (int i = 0; i < n; ++i) {
+    xs[i] = i + sign * hx[i];
+    ys[i] = j + sign * hy[i];
+    zs[i] = k + sign * hz[i];
+  }
+  int* kept = s.kept.data();
+  int count = 0;
+  if (support) {
+    // The voxel nearest to each source position, clamped into the volume (outside it the sample
+    // is 0 anyway except within half a voxel, which the clamp keeps): clamped in float, so the
+    // truncation is the floor, and vectorised.
+    const float top_x = v.nx - 0.5f, top_y = v.ny - 0.5f, top_z = v.nz - 0.5f;
+    if (v.count() <= static_cast<std::size_t>(std::numeric_limits<int>::max())) {
+      int* nearest = s.nearest.data();
+      const int row_y = v.nx, slice = v.nx * v.ny;  // int offsets: the volume has < 2^31 voxels
+#pragma omp simd
+      for (int i = 0; i < n; ++i) {
+        const int si = static_cast<int>(std::min(std::max(xs[i] + 0.5f, 0.0f), top_x));
+        const int sj = static_cast<int>(std::min(std::max(ys[i] + 0.5f, 0.0f), top_y));
+        const int sk = static_cast<int>(std::min(std::max(zs[i] + 0.5f, 0.0f), top_z));
+        nearest[i] = si + row_y * sj + slice * sk;
+      }
+      for (int i = 0; i < n; ++i) {
+        kept[count] = i;
+        count += support[nearest[i]] != 0;
+      }
+    } else {  // a larger volume: the same with 64-bit offsets, not vectorised
+      for (int i = 0; i < n; ++i) {
+        const int si = static_cast<int>(std::min(std::max(xs[i] + 0.5f, 0.0f), top_x));
+        const int sj = static_cast<int>(std::min(std::max(ys[i] + 0.5f, 0.0f), top_y));
+        const int sk = static_cast<int>(std::min(std::max(zs[i] + 0.5f, 0.0f), top_z));
+        kept[count] = i;
+        count += support[v.linear(si, sj, sk)] != 0;
+      }
+    }
+    std::fill(out, out + n, 0.0f);
+  } else {
+    for (int i = 0; i < n; ++i) kept[i] = i;
+    count = n;
+  }
+  for (int m = 0; m < count; ++m) {
+    const int i = kept[m];
+    const float x = xs[i], y = ys[i], z = zs[i];
+    if (interpolation == Interpolation::trilinear) {
+      out[i] = sample_trilinear(v, x, y, z);
+      continue;
+    }
+    const int ii = floor_int(x), jj = floor_int(y), kk = floor_int(z);
+    if (ii >= 1 && jj >= 1 && kk >= 1 && ii + 2 < v.nx && jj + 2 < v.ny && kk + 2 < v.nz) {
+      float wx[4], wy[4], wz[4];
+      bspline_weights(x - ii, wx);
+      bspline_weights(y - jj, wy);
+      bspline_weights(z - kk, wz);
+      out[i] = bspline_interior(v.data + v.linear(ii - 1, jj - 1, kk - 1), sy, sz, wx, wy, wz);
+    } else {
+      out[i] = sample_bspline(v, x, y, z);
+    }
+  }
+}
+
+}  // namespace
 
 void deform_pair(const VolumeView& a, const VolumeView& b, const VectorField& predictor, int factor,
                  Interpolation interpolation, std::vector<float>& out_a, std::vector<float>& out_b, int threads,
@@ -330,28 +441,41 @@ void deform_pair(const VolumeView& a, const VolumeView& b, const VectorField& pr
   out_b.resize(b.count());
   const double offset = 0.5 * (factor - 1);  // full-grid position of a binned voxel's centre
   const float half = 0.5f / factor;           // half the displacement, in binned voxels
+  const AxisCells cells = axis_cells(a.nx, factor, offset, predictor.origin.x, predictor.spacing.x, predictor.nx);
+  const int nodes_x = predictor.nx;
+  const std::uint8_t* mask_a = support_a.empty() ? nullptr : support_a.data();
+  const std::uint8_t* mask_b = support_b.empty() ? nullptr : support_b.data();
 #pragma omp parallel num_threads(thread_count(threads))
   {
   const FlushDenormals flush;
   RowPredictor along_row(predictor);  // the predictor's y-z interpolation once per row
+  std::vector<float> hx(a.nx), hy(a.nx), hz(a.nx), column(3 * static_cast<std::size_t>(nodes_x));
+  RowScratch scratch(a.nx);
+  // Tiles of kTileRows rows in y run through every z: the 4 x (kTileRows + 3) coefficient rows
+  // an output slice of a tile reads stay in cache for the next slices, so each coefficient is
+  // fetched from memory about once (slice by slice, each was fetched 4 times).
+  constexpr int kTileRows = 16;
+  const int tiles = (a.ny + kTileRows - 1) / kTileRows;
 #pragma omp for schedule(dynamic, 1)
+  for (int tile = 0; tile < tiles; ++tile)
   for (int k = 0; k < a.nz; ++k)
-    for (int j = 0; j < a.ny; ++j) {
-      const std::size_t row = a.linear(0, j, k);
+    for (int j = tile * kTileRows; j < std::min(a.ny, (tile + 1) * kTileRows); ++j) {
       along_row.set_row(j * factor + offset, k * factor + offset);
+      const double* c = along_row.columns();
+      for (std::size_t m = 0; m < column.size(); ++m) column[m] = static_cast<float>(c[m]);
+      // Half the predicted displacement at every voxel of the row, in voxels of this level.
       for (int i = 0; i < a.nx; ++i) {
-        const Vec3f d = along_row.at(i * factor + offset);
-        const float hx = d.x * half, hy = d.y * half, hz = d.z * half;
-        const bool signal_a = has_signal(support_a, a, i - hx, j - hy, k - hz);
-        const bool signal_b = has_signal(support_b, b, i + hx, j + hy, k + hz);
-        if (interpolation == Interpolation::trilinear) {
-          out_a[row + i] = signal_a ? sample_trilinear(a, i - hx, j - hy, k - hz) : 0.0f;
-          out_b[row + i] = signal_b ? sample_trilinear(b, i + hx, j + hy, k + hz) : 0.0f;
-        } else {
-          out_a[row + i] = signal_a ? sample_bspline(a, i - hx, j - hy, k - hz) : 0.0f;
-          out_b[row + i] = signal_b ? sample_bspline(b, i + hx, j + hy, k + hz) : 0.0f;
-        }
+        const int cell = cells.cell[i];
+        const float* c0 = column.data() + 3 * static_cast<std::size_t>(cell);
+        const float* c1 = nodes_x > 1 ? c0 + 3 : c0;
+        const float f = cells.frac[i];
+        hx[i] = (c0[0] + f * (c1[0] - c0[0])) * half;
+        hy[i] = (c0[1] + f * (c1[1] - c0[1])) * half;
+        hz[i] = (c0[2] + f * (c1[2] - c0[2])) * half;
       }
+      const std::size_t row = a.linear(0, j, k);
+      deform_row(a, mask_a, interpolation, j, k, -1.0f, hx.data(), hy.data(), hz.data(), scratch, out_a.data() + row);
+      deform_row(b, mask_b, interpolation, j, k, +1.0f, hx.data(), hy.data(), hz.data(), scratch, out_b.data() + row);
     }
   }
 }
