@@ -103,9 +103,10 @@ void ShadowLook::analyse(const Image& image, ShadowFrame& out) {
     m->values.assign(static_cast<std::size_t>(tx) * ty, std::numeric_limits<float>::quiet_NaN());
   }
 
-  // Local bright field: each tile's median (shadows are a minority of any tile), interpolated
-  // bilinearly between the tile centres (extrapolated linearly at the borders) so that the
-  // LED's fall-off across a tile does not read as noise.
+  // Local bright field: each tile's median (shadows are a minority of any tile), taken on
+  // every other pixel of every other row (a quarter of the cost, the same median within the
+  // noise), interpolated bilinearly between the tile centres (extrapolated linearly at the
+  // borders) so that the LED's fall-off across a tile does not read as noise.
   const std::size_t n = static_cast<std::size_t>(w) * h;
   normalised_.resize(n);
   std::vector<float> levels;
@@ -114,37 +115,47 @@ void ShadowLook::analyse(const Image& image, ShadowFrame& out) {
     for (int i = 0; i < tx; ++i) {
       tile_buffer_.clear();
       const int x1 = std::min(w, (i + 1) * t), y1 = std::min(h, (j + 1) * t);
-      for (int y = j * t; y < y1; ++y)
-        for (int x = i * t; x < x1; ++x) tile_buffer_.push_back(pixel(image, x, y));
+      for (int y = j * t; y < y1; y += 2)
+        for (int x = i * t; x < x1; x += 2) tile_buffer_.push_back(pixel(image, x, y));
       const double level = median_of(tile_buffer_);
       out.level_map.values[static_cast<std::size_t>(i + tx * j)] = static_cast<float>(level);
       if (level > 0) levels.push_back(static_cast<float>(level));
     }
   // Tile centres: (i + 0.5) t, except a partial last tile's, which is its own middle.
   const auto centre = [t](int i, int extent) { return 0.5 * (i * t + std::min(extent, (i + 1) * t)); };
-  const auto bracket = [&](double p, int tiles, int extent, int& i0, double& f) {
+  const auto bracket = [&](double p, int tiles, int extent, int& i0, float& f) {
     if (tiles < 2) {
       i0 = 0;
       f = 0;
       return;
     }
     i0 = std::clamp(static_cast<int>(std::floor(p / t - 0.5)), 0, tiles - 2);
-    f = (p - centre(i0, extent)) / (centre(i0 + 1, extent) - centre(i0, extent));
+    f = static_cast<float>((p - centre(i0, extent)) / (centre(i0 + 1, extent) - centre(i0, extent)));
   };
+  column_tile_.resize(static_cast<std::size_t>(w));
+  column_weight_.resize(static_cast<std::size_t>(w));
+  for (int x = 0; x < w; ++x) bracket(x + 0.5, tx, w, column_tile_[static_cast<std::size_t>(x)], column_weight_[static_cast<std::size_t>(x)]);
+  row_levels_.resize(static_cast<std::size_t>(tx));
   for (int y = 0; y < h; ++y) {
     int j0 = 0;
-    double fy = 0;
+    float fy = 0;
     bracket(y + 0.5, ty, h, j0, fy);
     const int j1 = std::min(j0 + 1, ty - 1);
-    for (int x = 0; x < w; ++x) {
-      int i0 = 0;
-      double fx = 0;
-      bracket(x + 0.5, tx, w, i0, fx);
-      const int i1 = std::min(i0 + 1, tx - 1);
-      const auto at = [&](int i, int j) { return static_cast<double>(out.level_map.values[static_cast<std::size_t>(i + tx * j)]); };
-      const double level = (1 - fy) * ((1 - fx) * at(i0, j0) + fx * at(i1, j0)) + fy * ((1 - fx) * at(i0, j1) + fx * at(i1, j1));
-      normalised_[static_cast<std::size_t>(y) * w + x] = level > 0 ? static_cast<float>(pixel(image, x, y) / level) : 1.0f;
-    }
+    for (int i = 0; i < tx; ++i)
+      row_levels_[static_cast<std::size_t>(i)] = (1 - fy) * out.level_map.values[static_cast<std::size_t>(i + tx * j0)] +
+                                                 fy * out.level_map.values[static_cast<std::size_t>(i + tx * j1)];
+    float* row = normalised_.data() + static_cast<std::size_t>(y) * w;
+    const auto normalise = [&](const auto* in) {
+      for (int x = 0; x < w; ++x) {
+        const int i0 = column_tile_[static_cast<std::size_t>(x)];
+        const int i1 = std::min(i0 + 1, tx - 1);
+        const float fx = column_weight_[static_cast<std::size_t>(x)];
+        const float level = (1 - fx) * row_levels_[static_cast<std::size_t>(i0)] + fx * row_levels_[static_cast<std::size_t>(i1)];
+        row[x] = level > 0 ? static_cast<float>(in[x]) / level : 1.0f;
+      }
+    };
+    if (image.type() == SampleType::u16) normalise(image.row<std::uint16_t>(y));
+    else normalise(image.row<std::uint8_t>(y));
   }
   if (levels.empty()) {
     // A dark frame: no bright field at all (the LED did not fire).

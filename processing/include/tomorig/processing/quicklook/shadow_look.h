@@ -89,6 +89,9 @@ class ShadowLook {
   ShadowLookOptions options_;
   std::vector<float> normalised_;       // I / tile level
   std::vector<float> tile_buffer_;      // one tile's samples for the median
+  std::vector<int> column_tile_;        // per column: the left tile of its interpolation
+  std::vector<float> column_weight_;    // per column: the right tile's weight
+  std::vector<float> row_levels_;       // the bright field of the current row at the tile columns
   std::vector<std::int32_t> labels_;    // union-find parents of shadow pixels (-1: none)
   std::vector<std::uint32_t> sizes_;    // group sizes by root
   std::vector<double> reference_samples_[2];
