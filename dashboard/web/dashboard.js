@@ -133,7 +133,7 @@ function cameraHealth(id) {
   const cam = state.status && (state.status.cameras || []).find((c) => c.id === id);
   const ql = state.quicklook && (state.quicklook.cameras || []).find((c) => c.id === id);
   if (cam && cam.connected === false) return ['red', 'disconnected: ' + (cam.problem || 'no reason given')];
-  if (ql && ql.statistics === null) return ['red', 'frame missing' + (ql.missing ? ': ' + ql.missing : '')];
+  if (ql && ql.statistics === null && !ql.shadow) return ['red', 'frame missing' + (ql.missing ? ': ' + ql.missing : '')];
   if (cam && cam.frames_lost > 0) return ['amber', cam.frames_lost + ' frames lost'];
   if (!cam && !ql) return ['', 'no data'];
   return ['green', 'ok'];
@@ -148,6 +148,18 @@ function renderTileHealth(id) {
   tile.lost.textContent = cam ? `frames ${cam.frames}, lost ${cam.frames_lost}, incomplete sets ${cam.incomplete_sets}` : '';
 }
 
+// A shadowgraphy rig's camera (the quick-look's shadow mode, docs/spray.md): its spray figures
+// and LED alarms in one line, as the particle gauges have nothing to show.
+function shadowSummary(sh) {
+  const a = sh.a || {};
+  const bright = a.bright_field ? num(a.bright_field.level) : null;
+  const shadows = a.shadows ? a.shadows.count : null;
+  const text = `bright ${fmt(bright, 0)} counts, ${shadows === null ? '-' : shadows} shadows, ` +
+    `LED B/A ${fmt(judgedValue(sh.energy_ratio), 2)} (${judgedFlag(sh.energy_ratio)})`;
+  const alarms = sh.led_energy_alarms || [];
+  return alarms.length ? text + ': ' + alarms.join('; ') : text;
+}
+
 function renderQuickLook() {
   const q = state.quicklook;
   if (!q) return;
@@ -159,7 +171,7 @@ function renderQuickLook() {
     const tile = tileFor(cam.id);
     if (images.has(cam.id + '/a')) tile.thumb.src = withToken(`/image/${cam.id}/a?set=${q.set}`);
     const s = cam.statistics;
-    tile.thumb.classList.toggle('stale', !s);  // the frame is missing: the picture is an older one
+    tile.thumb.classList.toggle('stale', !s && !cam.shadow);  // the frame is missing: the picture is an older one
     drawHistogram(tile.histogram, s && s.a ? s.a.histogram : null,
       s && s.a && s.a.saturation ? judgedValue(s.a.saturation.fraction) : null);
     for (const [, key, pick, digits] of FIGURES) {
@@ -176,7 +188,8 @@ function renderQuickLook() {
       gauge.value.textContent = fmt(judgedValue(j), digits);
       gauge.value.className = 'value ' + judgedFlag(j) + '-text';
     }
-    tile.reason.textContent = cam.statistics === null ? 'not measured: ' + (cam.missing || '') : '';
+    tile.reason.textContent = cam.shadow ? shadowSummary(cam.shadow)
+      : cam.statistics === null ? 'not measured: ' + (cam.missing || '') : '';
     tile.shownSet = q.set;
     renderTileHealth(cam.id);
   }

@@ -10,11 +10,10 @@
 #include <fmt/core.h>
 
 #include "tomorig/rig/buffer_memory.h"
-#include "tomorig/rig/simulate_session.h"
+#include "tomorig/rig/simulated_scene.h"
 #include "tomorig/acquisition/aravis_camera.h"
 #include "tomorig/acquisition/gentl_camera.h"
 #include "tomorig/core/error.h"
-#include "tomorig/simulators/simulated_rig.h"
 #include "tomorig/trigger/rig_trigger.h"
 #include "tomorig/trigger/trigger_device.h"
 
@@ -113,10 +112,8 @@ RigAcquisition::RigAcquisition(const config::RigConfig& rig, RigAcquisitionOptio
   if (simulated != 0) {
     if (!rig_.simulation)
       throw bad_input("the rig has simulated cameras but no [simulation] table; add one (see 'tomorig config default')");
-    simulator_ = std::make_unique<sim::SimulatedRig>(simulation_options_from(rig_));
-    for (const auto& cam : simulator_->cameras())
-      session_cameras_.push_back(
-          {cam.spec.id, cam.spec.width, cam.spec.height, cam.spec.pixel_format, cam.spec.pixel_pitch_um});
+    simulator_ = make_simulated_scene(rig_);
+    session_cameras_ = simulator_->cameras();
     for (const auto& cam : rig_.cameras) {
       const auto fault = options_.faults.find(cam.id);
       auto camera = std::make_unique<acquisition::SimulatedCamera>(
@@ -275,13 +272,13 @@ void RigAcquisition::handle_event(std::uint64_t index, std::int64_t timestamp_ns
   if (simulator_) {
     // Rendering is the simulated cameras' exposure and readout: the set's timeout starts when
     // they deliver, not before (a slow machine would otherwise time every set out).
-    sim::SimulatedSet set = simulator_->render_set(index, dt_ns);
+    SceneSet set = simulator_->render(index, dt_ns);
     assembler_->add_trigger(input);
     for (auto& frames : set.frames.cameras)
       rendered_[frames.camera_id] = {std::move(frames.a.image), std::move(frames.b.image)};
     if (options_.keep_truth) {
       std::lock_guard lock(mutex_);
-      truth_[index] = {std::move(set.particles_a), std::move(set.particles_b)};
+      truth_[index] = std::move(set.truth);
     }
     for (auto* camera : simulated_cameras_) camera->trigger(input);
     rendered_.clear();  // frames of a camera that has vanished
@@ -406,14 +403,7 @@ RigProgress RigAcquisition::progress() const {
 
 std::optional<storage::SessionTruth> RigAcquisition::session_truth() const {
   if (!simulator_ || !options_.keep_truth) return std::nullopt;
-  storage::SessionTruth truth;
-  truth.case_name = simulator_->case_definition().name;
-  truth.flow_name = simulator_->flow().name();
-  truth.flow_parameters = simulator_->flow().parameters_json();
-  truth.seed = simulator_->options().seed;
-  truth.ppp = simulator_->options().ppp;
-  for (const auto& cam : simulator_->cameras()) truth.cameras.push_back(truth_camera_of(cam));
-  return truth;
+  return simulator_->truth();
 }
 
 std::optional<storage::TruthSet> RigAcquisition::take_truth(std::uint64_t trigger_index) {

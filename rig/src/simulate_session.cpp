@@ -10,6 +10,7 @@
 
 #include "tomorig/core/error.h"
 #include "tomorig/core/version.h"
+#include "tomorig/rig/simulated_scene.h"
 
 namespace tomorig::rig {
 namespace {
@@ -112,15 +113,12 @@ SimulationSummary run_simulation_to_session(const config::RigConfig& rig, const 
                                             const std::function<bool()>& should_stop) {
   const auto start = Clock::now();
   // Everything that can be wrong with the input is found here, before a file exists.
-  const sim::SimulationOptions options = simulation_options_from(rig);
+  const std::unique_ptr<SimulatedScene> scene = make_simulated_scene(rig);
   const int sets = rig.simulation->sets;
   if (sets < 1) throw bad_input(fmt::format("simulation.sets = {} must be >= 1", sets));
-  const sim::SimulatedRig simulated(options);
 
   storage::SessionInfo info;
-  for (const sim::SimulatedCamera& cam : simulated.cameras())
-    info.cameras.push_back({cam.spec.id, cam.spec.width, cam.spec.height, cam.spec.pixel_format,
-                            cam.spec.pixel_pitch_um});
+  info.cameras = scene->cameras();
   info.rig_config_toml = rig.source_text;
   info.software_version = std::string(software_version());
   info.compression = compression;
@@ -131,30 +129,21 @@ SimulationSummary run_simulation_to_session(const config::RigConfig& rig, const 
   writer_options.overwrite = overwrite;
   storage::SessionWriter writer(out, info, writer_options);
 
-  storage::SessionTruth truth;
-  truth.case_name = simulated.case_definition().name;
-  truth.flow_name = simulated.flow().name();
-  truth.flow_parameters = simulated.flow().parameters_json();
-  truth.seed = options.seed;
-  truth.ppp = options.ppp;
-  for (const sim::SimulatedCamera& cam : simulated.cameras()) truth.cameras.push_back(truth_camera_of(cam));
+  const storage::SessionTruth truth = scene->truth();
   writer.write_truth(truth);
 
   // Render set k + 1 while set k is written: the two take similar time on tpiv-thesis, and
   // the writer is single-threaded. At most two sets are in memory.
-  auto render = [&simulated](int k) { return simulated.render_set(static_cast<std::uint64_t>(k)); };
-  std::future<sim::SimulatedSet> next = std::async(std::launch::async, render, 0);
+  auto render = [&scene](int k) { return scene->render(static_cast<std::uint64_t>(k), scene->nominal_dt_ns()); };
+  std::future<SceneSet> next = std::async(std::launch::async, render, 0);
   auto previous_done = Clock::now();
   int written = 0;
   for (int k = 0; k < sets; ++k) {
-    sim::SimulatedSet set = next.get();
+    SceneSet set = next.get();
     if (should_stop && should_stop()) break;  // the set rendered ahead is dropped, never half-written
     if (k + 1 < sets) next = std::async(std::launch::async, render, k + 1);
     writer.append(set.frames);
-    storage::TruthSet truth_set;
-    truth_set.particles_a = std::move(set.particles_a);
-    truth_set.particles_b = std::move(set.particles_b);
-    writer.write_truth_set(static_cast<std::uint64_t>(k), truth_set);
+    writer.write_truth_set(static_cast<std::uint64_t>(k), set.truth);
     if (progress) progress(static_cast<std::uint64_t>(k) + 1, static_cast<std::uint64_t>(sets), seconds_since(previous_done));
     previous_done = Clock::now();
     written = k + 1;
@@ -164,8 +153,8 @@ SimulationSummary run_simulation_to_session(const config::RigConfig& rig, const 
   SimulationSummary summary;
   summary.case_name = truth.case_name;
   summary.sets = static_cast<std::uint64_t>(written);
-  summary.cameras = simulated.cameras().size();
-  summary.particles_per_set = simulated.particles_per_set();
+  summary.cameras = scene->cameras().size();
+  summary.particles_per_set = scene->particles_per_set();
   summary.output = out;
   std::error_code ec;
   const auto size = std::filesystem::file_size(out, ec);

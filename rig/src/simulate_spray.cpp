@@ -1,6 +1,7 @@
 // The spray-thesis case as a session file, truth alongside.
 #include "tomorig/rig/simulate_spray.h"
 #include "tomorig/rig/simulate_session.h"
+#include "simulate_spray_truth.h"
 
 #include <chrono>
 
@@ -31,9 +32,7 @@ std::string spray_optics_setup_toml(const sim::SprayCase& c) {
   return t;
 }
 
-namespace {
-
-nlohmann::json cameras_json(const sim::SprayCase& c) {
+nlohmann::json spray_cameras_json(const sim::SprayCase& c) {
   nlohmann::json cams = nlohmann::json::array();
   for (const sim::SprayCamera& cam : c.cameras) {
     nlohmann::json z = nlohmann::json::array(), chi = nlohmann::json::array();
@@ -54,7 +53,29 @@ nlohmann::json cameras_json(const sim::SprayCase& c) {
   return cams;
 }
 
-storage::SessionTruth truth_of(const sim::SprayCase& c, const std::string& flow_name, const nlohmann::json& parameters) {
+nlohmann::json spray_parameters_json(const sim::SprayCase& c) {
+  return {{"pattern", sim::to_string(c.options.pattern)},
+          {"reduced", c.options.reduced},
+          {"droplets_per_set", c.options.droplets},
+          {"d_median_um", c.options.d_median_um},
+          {"d_log_sigma", c.options.d_log_sigma},
+          {"d_range_um", {c.options.d_min_um, c.options.d_max_um}},
+          {"dt_us", c.options.dt_us},
+          {"bright_fraction", c.options.bright_fraction},
+          {"vignetting", c.options.vignetting},
+          {"pulse_jitter", c.options.pulse_jitter},
+          {"pulse_b_energy", c.options.pulse_b_energy},
+          {"noise", c.options.noise},
+          {"liquid", c.optics.liquid.name},
+          {"led", {{"peak_nm", c.optics.spectrum.peak_nm}, {"fwhm_nm", c.optics.spectrum.fwhm_nm}}},
+          {"volume_mm",
+           {{c.volume_min.x, c.volume_min.y, c.volume_min.z}, {c.volume_max.x, c.volume_max.y, c.volume_max.z}}},
+          {"cameras", spray_cameras_json(c)},
+          {"visible", "visible_mask bit c: the droplet's own shadow at pulse A reaches camera c's threshold 1 - 2 noise"},
+          {"optics_setup_toml", spray_optics_setup_toml(c)}};
+}
+
+storage::SessionTruth spray_truth(const sim::SprayCase& c, const std::string& flow_name, const nlohmann::json& parameters) {
   storage::SessionTruth truth;
   truth.case_name = c.name;
   truth.flow_name = flow_name;
@@ -65,17 +86,19 @@ storage::SessionTruth truth_of(const sim::SprayCase& c, const std::string& flow_
   return truth;
 }
 
-storage::SessionInfo info_of(const sim::SprayCase& c, storage::Compression compression, const std::string& comment) {
+storage::SessionWriter open_spray_writer(const std::filesystem::path& out, const sim::SprayCase& c,
+                                         storage::Compression compression, bool overwrite, const std::string& comment) {
   storage::SessionInfo info;
   for (const sim::SprayCamera& cam : c.cameras)
     info.cameras.push_back({cam.id, cam.width, cam.height, PixelFormat::Mono16, cam.pixel_pitch_um});
   info.rig_config_toml = comment;
   info.software_version = std::string(software_version());
   info.compression = compression;
-  return info;
+  storage::SessionWriterOptions wo;
+  wo.compression = compression;
+  wo.overwrite = overwrite;
+  return storage::SessionWriter(out, info, wo);
 }
-
-}  // namespace
 
 std::string write_spray_target_session(const sim::SprayOptions& options, const std::filesystem::path& out,
                                        storage::Compression compression, bool overwrite) {
@@ -88,18 +111,13 @@ std::string write_spray_target_session(const sim::SprayOptions& options, const s
   const nlohmann::json parameters = {{"target", "bars: 1 mm clear, 1 mm chromium (5 %), slanted 4 deg from y"},
                                      {"planes", planes},
                                      {"reduced", c.options.reduced},
-                                     {"cameras", cameras_json(c)},
+                                     {"cameras", spray_cameras_json(c)},
                                      {"optics_setup_toml", spray_optics_setup_toml(c)}};
-  storage::SessionWriterOptions wo;
-  wo.compression = compression;
-  wo.overwrite = overwrite;
-  storage::SessionWriter writer(
-      out,
-      info_of(c, compression,
-              "# Written by `tomorig simulate --case spray-thesis --targets`: set k shows a slanted bar photomask at\n"
-              "# depth k (planes[k].z_mm in /truth flow_parameters), for `tomorig optics psf`. No rig config applies.\n"),
-      wo);
-  writer.write_truth(truth_of(c, "traverse", parameters));
+  storage::SessionWriter writer = open_spray_writer(
+      out, c, compression, overwrite,
+      "# Written by `tomorig simulate --case spray-thesis --targets`: set k shows a slanted bar photomask at\n"
+      "# depth k (planes[k].z_mm in /truth flow_parameters), for `tomorig optics psf`. No rig config applies.\n");
+  writer.write_truth(spray_truth(c, "traverse", parameters));
   for (std::size_t k = 0; k < depths.size(); ++k) {
     FrameSet set;
     set.set_index = k;
@@ -154,36 +172,28 @@ std::string write_spray_session(const sim::SprayOptions& options, int sets, cons
     rendered.push_back(std::move(s));
     if (progress) progress(k + 1, sets);
   }
-  const nlohmann::json truth_json = {
-      {"pattern", sim::to_string(c.options.pattern)},
-      {"reduced", c.options.reduced},
-      {"droplets_per_set", c.options.droplets},
-      {"d_median_um", c.options.d_median_um},
-      {"d_log_sigma", c.options.d_log_sigma},
-      {"d_range_um", {c.options.d_min_um, c.options.d_max_um}},
-      {"dt_us", c.options.dt_us},
-      {"bright_fraction", c.options.bright_fraction},
-      {"vignetting", c.options.vignetting},
-      {"pulse_jitter", c.options.pulse_jitter},
-      {"liquid", c.optics.liquid.name},
-      {"led", {{"peak_nm", c.optics.spectrum.peak_nm}, {"fwhm_nm", c.optics.spectrum.fwhm_nm}}},
-      {"volume_mm", {{c.volume_min.x, c.volume_min.y, c.volume_min.z}, {c.volume_max.x, c.volume_max.y, c.volume_max.z}}},
-      {"cameras", cameras_json(c)},
-      {"visible", "visible_mask bit c: the droplet's own shadow at pulse A reaches camera c's threshold 1 - 2 noise"},
-      {"optics_setup_toml", spray_optics_setup_toml(c)},
-      {"sets", set_truth}};
+  // The truth's JSON is an HDF5 attribute, which holds at most 64 KiB: the per-set records go
+  // in while they fit (800 reduced droplets take ~35 kB a set; a full-size set does not fit).
+  // Any set's droplets, sizes included, are regenerated by sim::spray_droplets(case, k).
+  constexpr std::size_t kTruthBudget = 60'000;
+  nlohmann::json truth_json = spray_parameters_json(c);
+  std::size_t size = truth_json.dump().size();
+  nlohmann::json recorded = nlohmann::json::array();
+  for (nlohmann::json& record : set_truth) {
+    const std::size_t record_size = record.dump().size() + 1;
+    if (size + record_size > kTruthBudget) break;
+    size += record_size;
+    recorded.push_back(std::move(record));
+  }
+  truth_json["sets_recorded"] = recorded.size();
+  truth_json["sets"] = std::move(recorded);
 
-  storage::SessionWriterOptions wo;
-  wo.compression = compression;
-  wo.overwrite = overwrite;
-  storage::SessionWriter writer(
-      out,
-      info_of(c, compression,
-              fmt::format("# Written by `tomorig simulate --case spray-thesis`{}: {} droplets per set, pattern {}; the "
-                          "truth\n# (flow_parameters) holds the optics set-up and every droplet. No rig config applies.\n",
-                          c.options.reduced ? " --reduced" : "", c.options.droplets, sim::to_string(c.options.pattern))),
-      wo);
-  writer.write_truth(truth_of(c, sim::to_string(c.options.pattern), truth_json));
+  storage::SessionWriter writer = open_spray_writer(
+      out, c, compression, overwrite,
+      fmt::format("# Written by `tomorig simulate --case spray-thesis`{}: {} droplets per set, pattern {}; the "
+                  "truth\n# (flow_parameters) holds the optics set-up and every droplet. No rig config applies.\n",
+                  c.options.reduced ? " --reduced" : "", c.options.droplets, sim::to_string(c.options.pattern)));
+  writer.write_truth(spray_truth(c, sim::to_string(c.options.pattern), truth_json));
   for (int k = 0; k < sets; ++k) {
     sim::SpraySet& s = rendered[static_cast<std::size_t>(k)];
     s.frames.trigger_timestamp_ns = static_cast<std::int64_t>(k) * 40'000'000;  // 25 Hz (Sect. 7.3)

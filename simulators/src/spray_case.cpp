@@ -54,6 +54,8 @@ void SprayOptions::validate() const {
   if (!(bright_fraction > 0 && bright_fraction <= 0.9))
     throw bad_input(fmt::format("spray: bright_fraction = {} must be in (0, 0.9]", bright_fraction));
   if (!(vignetting >= 0 && vignetting < 0.9)) throw bad_input(fmt::format("spray: vignetting = {} must be in [0, 0.9)", vignetting));
+  if (!(pulse_b_energy > 0 && pulse_b_energy <= 2))
+    throw bad_input(fmt::format("spray: pulse_b_energy = {} must be in (0, 2]", pulse_b_energy));
   if (!(pulse_jitter >= 0 && pulse_jitter < 0.5)) throw bad_input(fmt::format("spray: pulse_jitter = {} must be in [0, 0.5)", pulse_jitter));
 }
 

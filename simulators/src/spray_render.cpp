@@ -6,6 +6,8 @@
 #include <random>
 #include <vector>
 
+#include <fmt/core.h>
+
 #include "parallel.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/optics/droplet_image.h"
@@ -125,8 +127,25 @@ double pulse_energy(const SprayCase& c, std::uint64_t stream, std::uint64_t inde
 }  // namespace
 
 SpraySet render_spray_set(const SprayCase& c, std::uint64_t set_index) {
+  return render_spray_set(c, set_index, std::llround(c.options.dt_us * 1e3));
+}
+
+SpraySet render_spray_set(const SprayCase& c, std::uint64_t set_index, std::int64_t dt_ns) {
+  if (dt_ns < 0) throw bad_input(fmt::format("spray: set {}: dt_ns = {} must be >= 0", set_index, dt_ns));
+  const std::int64_t nominal_ns = std::llround(c.options.dt_us * 1e3);
+  if (nominal_ns == 0 && dt_ns != 0)
+    throw bad_input(fmt::format("spray: set {}: dt_ns = {} cannot be rendered: the case's dt_us is 0", set_index, dt_ns));
   SpraySet out;
   out.droplets = spray_droplets(c, set_index);
+  if (dt_ns != nominal_ns) {
+    // Steady droplet motion over the pulse separation: only the half-displacements scale.
+    const double scale = static_cast<double>(dt_ns) / static_cast<double>(nominal_ns);
+    for (Droplet& d : out.droplets) {
+      const Vec3d mid = (d.a + d.b) * 0.5, half = (d.b - d.a) * (0.5 * scale);
+      d.a = mid - half;
+      d.b = mid + half;
+    }
+  }
   const std::vector<optics::TransmissionTable> tables = transmission_tables(c);
   const std::size_t ncam = c.cameras.size();
   for (Droplet& d : out.droplets) {
@@ -136,7 +155,7 @@ SpraySet render_spray_set(const SprayCase& c, std::uint64_t set_index) {
   const double level = c.options.bright_fraction * 65535.0;
   out.frames.set_index = set_index;
   out.frames.trigger_index = set_index;
-  out.frames.dt_ns = std::llround(c.options.dt_us * 1e3);
+  out.frames.dt_ns = dt_ns;
   out.frames.cameras.resize(ncam);
   out.pulse_energy_a.resize(ncam);
   out.pulse_energy_b.resize(ncam);
@@ -169,7 +188,7 @@ SpraySet render_spray_set(const SprayCase& c, std::uint64_t set_index) {
           }
         if (e == 0 && pr.in_view) deepest_a[ci][di] = deepest;
       }
-      const double energy = pulse_energy(c, kPulseStream, set_index, ci, e);
+      const double energy = pulse_energy(c, kPulseStream, set_index, ci, e) * (e == 0 ? 1.0 : c.options.pulse_b_energy);
       (e == 0 ? out.pulse_energy_a : out.pulse_energy_b)[ci] = energy;
       Image signal = Image::allocate(cam.width, cam.height, SampleType::f32);
       for (int y = 0; y < cam.height; ++y) {

@@ -56,6 +56,35 @@ void to_json(nlohmann::json& j, const CameraQuickLook& s) {
   j = {{"a", s.a}, {"b", s.b}, {"energy_balance", s.energy_balance}, {"flag", s.overall()}};
 }
 
+void to_json(nlohmann::json& j, const ShadowFrame& s) {
+  j = {{"width", s.width},
+       {"height", s.height},
+       {"bright_field",
+        {{"level", number(s.bright_level)},
+         {"fraction", number(s.bright_fraction)},
+         {"noise", number(s.noise)},
+         {"uniformity", s.uniformity},
+         {"map", s.level_map}}},
+       {"shadows",
+        {{"threshold", number(s.threshold)},
+         {"coverage", s.shadow_coverage},
+         {"count", s.shadows},
+         {"per_mpx", number(s.shadows_per_mpx)},
+         {"min_intensity", number(s.min_intensity)},
+         {"spray_tile_fraction", s.spray_tile_fraction},
+         {"map", s.coverage_map}}},
+       {"flag", s.overall()}};
+}
+
+void to_json(nlohmann::json& j, const ShadowCameraLook& s) {
+  j = {{"a", s.a},
+       {"b", s.b},
+       {"energy_ratio", s.energy_ratio},
+       {"history", s.reference_ready ? nlohmann::json{{"a", s.history_a}, {"b", s.history_b}} : nlohmann::json(nullptr)},
+       {"led_energy_alarms", s.alarms},
+       {"flag", s.overall()}};
+}
+
 void to_json(nlohmann::json& j, const DtCheckResult& r) {
   nlohmann::json windows = nlohmann::json::array();
   for (const DtWindow& w : r.windows)

@@ -121,6 +121,10 @@ struct SimulationConfig {
   double read_noise_e = 5.0;      // electrons, 1 sigma
   double peak_counts = 1000.0;    // peak intensity of a particle image
   std::string light_sheet = "uniform";  // "uniform" | "gaussian" | "tophat"
+  // spray-thesis only (docs/spray.md): the droplet pattern, and LED pulse B's energy relative
+  // to pulse A (1: equal; 0.8: a 20 % drop, which the spray quick-look flags).
+  std::string spray = "jet-in-crossflow";  // "jet-in-crossflow" | "hollow-cone"
+  double pulse_b_energy = 1.0;
 };
 
 // [quicklook], [quicklook.dt_check], [quicklook.drift], [quicklook.preview]: the targets and

@@ -39,6 +39,7 @@ constexpr int kHistogramHeight = 64;
 
 Flag CameraResult::flag() const {
   if (!measured) return Flag::red;
+  if (shadow) return shadow_look.overall();
   return quicklook::worst(statistics.overall(), dt_check.overall());
 }
 
@@ -87,7 +88,11 @@ stream::PreviewMessage set_message(const FrameSet& set, const std::vector<Camera
     const CameraResult& r = cameras[c];
     overall = quicklook::worst(overall, r.flag());
     json cam = {{"id", r.id}, {"flag", r.flag()}};
-    if (r.measured) {
+    if (r.measured && r.shadow) {
+      cam["statistics"] = nullptr;
+      cam["dt_check"] = nullptr;
+      cam["shadow"] = r.shadow_look;
+    } else if (r.measured) {
       cam["statistics"] = r.statistics;
       cam["dt_check"] = r.dt_check;
     } else {
@@ -100,7 +105,7 @@ stream::PreviewMessage set_message(const FrameSet& set, const std::vector<Camera
     if (a.present()) {
       attach(message, images, quicklook::thumbnail(a.image, thumbnail_px),
              {{"name", r.id + "/a"}, {"kind", "thumbnail"}, {"camera", r.id}});
-      if (r.measured) {
+      if (r.measured && !r.shadow) {
         const auto& h = r.statistics.a.histogram;
         attach(message, images, quicklook::histogram_image(h, static_cast<int>(std::min<std::size_t>(h.size(), 256)),
                                                            kHistogramHeight),
@@ -161,7 +166,16 @@ storage::QuickLookRecord statistics_record(std::uint64_t set, const std::vector<
     storage::QuickLookCameraRecord c;
     c.flag = flag_code(cam.flag());
     overall = quicklook::worst(overall, cam.flag());
-    if (cam.measured) {
+    if (cam.measured && cam.shadow) {
+      // The particle columns hold the shadow figures that share their meaning: the bright
+      // field as the background and its noise, pulse B over A as the energy balance.
+      const quicklook::ShadowFrame* frames[2] = {&cam.shadow_look.a, &cam.shadow_look.b};
+      for (int e = 0; e < 2; ++e) {
+        c.background[e] = as_float(frames[e]->bright_level);
+        c.noise[e] = as_float(frames[e]->noise * frames[e]->bright_level);
+      }
+      c.energy_balance = as_float(cam.shadow_look.energy_ratio.value);
+    } else if (cam.measured) {
       const quicklook::FrameStatistics* frames[2] = {&cam.statistics.a, &cam.statistics.b};
       for (int e = 0; e < 2; ++e) {
         const quicklook::FrameStatistics& f = *frames[e];

@@ -11,6 +11,7 @@
 #include "tomorig/processing/quicklook/drift_monitor.h"
 #include "tomorig/processing/quicklook/dt_check.h"
 #include "tomorig/processing/quicklook/preview_volume.h"
+#include "tomorig/processing/quicklook/shadow_look.h"
 #include "tomorig/processing/quicklook/statistics.h"
 #include "tomorig/storage/quicklook_record.h"
 #include "tomorig/stream/preview.h"
@@ -26,6 +27,10 @@ struct CameraResult {
   std::string missing;       // why not, e.g. "frame B missing"
   quicklook::CameraQuickLook statistics;
   quicklook::DtCheckResult dt_check;
+  // A shadowgraphy rig (the stage's shadow mode): the spray quick-look replaces the particle
+  // statistics and the Δt check.
+  bool shadow = false;
+  quicklook::ShadowCameraLook shadow_look;
   quicklook::Flag flag() const;
 };
 

@@ -10,6 +10,9 @@
 //   --stage quicklook:preview=off                      statistics and Δt check only
 //   --stage quicklook:preview=ment,threads=2           MENT previews on two threads
 //   --stage quicklook:nice=5,preview_nice=10           the threads' nice values (the defaults)
+//   --stage quicklook:shadow=on                        the spray quick-look (shadow_look.h) in place of
+//                                                      particle statistics; auto (default): on for a
+//                                                      spray-thesis recording or a rig lit by LEDs only
 //
 // The recorder comes first: the stage's threads run at raised nice values (thread_priority.h),
 // the statistics of every set above the preview volume, which skips sets to stay current.
@@ -59,6 +62,9 @@ class QuickLookStage final : public Stage {
     if (thumbnail_px_ < 16 || thumbnail_px_ > 1024)
       throw bad_input(fmt::format("stage 'quicklook': thumbnail_px = {} is out of range: use 16 to 1024", thumbnail_px_));
     calib_ = table.text("calib", calib_);
+    shadow_ = table.text("shadow", shadow_);
+    if (shadow_ != "auto" && shadow_ != "on" && shadow_ != "off")
+      throw bad_input(fmt::format("stage 'quicklook': shadow = {} is not one of auto, on, off", shadow_));
     for (auto [key, value] : {std::pair{"nice", &nice_}, std::pair{"preview_nice", &preview_nice_}}) {
       *value = static_cast<int>(table.integer(key, *value));
       if (*value < 0 || *value > 19)
@@ -85,14 +91,20 @@ class QuickLookStage final : public Stage {
     settings_ = settings;
     store_quicklook_ = store_ ? recording.store_quicklook : nullptr;
 
+    shadow_mode_ = shadow_ == "on" || (shadow_ == "auto" && is_shadowgraphy(recording));
     for (const storage::SessionCamera& camera : recording.cameras) {
       quicklook::QuickLookOptions options = settings.statistics;
       options.bit_depth = bit_depth(camera.pixel_format);
       statistics_.emplace_back(options);
       dt_checks_.emplace_back(settings.dt_check);
-      results_.push_back({.id = camera.id});
+      quicklook::ShadowLookOptions shadow;
+      shadow.bit_depth = options.bit_depth;
+      shadow_looks_.emplace_back(shadow);
+      results_.push_back({.id = camera.id, .shadow = shadow_mode_});
     }
-    if (preview_ != "off") start_preview(recording, settings);
+    // The preview volume reconstructs particle light; shadow images would need inverting and
+    // flat-fielding first (issue 20's processing presets), so shadow mode has no preview yet.
+    if (preview_ != "off" && !shadow_mode_) start_preview(recording, settings);
   }
 
   void process(const FrameSet& set) override {
@@ -125,6 +137,15 @@ class QuickLookStage final : public Stage {
       if (!r.measured) continue;
       // A frame these kernels cannot take (too small, float) is reported for its camera; it
       // does not stop the quick-look of the others.
+      if (shadow_mode_) {
+        try {
+          shadow_looks_[c].analyse(frames.a.image, frames.b.image, r.shadow_look);
+        } catch (const Error& e) {
+          r.measured = false;
+          r.missing = e.what();
+        }
+        continue;
+      }
       try {
         statistics_[c].analyse(frames.a.image, frames.b.image, r.statistics);
         backgrounds[c] = r.statistics.a.background;
@@ -179,7 +200,8 @@ class QuickLookStage final : public Stage {
     }
     j["publish"] = publisher_ ? nlohmann::json(publisher_->endpoint()) : nlohmann::json(nullptr);
     const PreviewWorker::State s = worker_ ? worker_->state() : final_state_;
-    j["preview"] = preview_ == "off"        ? nlohmann::json("off")
+    j["mode"] = shadow_mode_ ? "shadow" : "particles";
+    j["preview"] = preview_ == "off" || shadow_mode_ ? nlohmann::json("off")
                    : !s.disabled.empty() ? nlohmann::json(fmt::format("off: {}", s.disabled))
                                          : nlohmann::json(settings_.preview.algorithm);
     j["preview_failures"] = s.failures;
@@ -200,6 +222,17 @@ class QuickLookStage final : public Stage {
   bool may_skip() const override { return true; }
 
  private:
+  // A recording of a shadowgraphy rig: the spray-thesis simulation, or a rig whose light
+  // sources are all LEDs (inline LED back-lighting, thesis Ch. 6-7).
+  static bool is_shadowgraphy(const SessionDescription& recording) {
+    if (recording.truth && recording.truth->case_name == "spray-thesis") return true;
+    const config::RigConfig* rig = recording.rig_config();
+    if (rig == nullptr || rig->trigger.light_sources.empty()) return false;
+    for (const config::LightSourceConfig& source : rig->trigger.light_sources)
+      if (source.kind != "led") return false;
+    return true;
+  }
+
   // The preview volume and drift monitor need the cameras' models: the truth of a simulated
   // recording, or the rig's calibration. Without them the statistics still run. They are built
   // on the preview thread, so that begin() (on the recorder's thread) returns at once.
@@ -247,6 +280,9 @@ class QuickLookStage final : public Stage {
   std::atomic<double> cpu_seconds_{0.0};
   std::string priority_error_;
   std::string calib_;
+  std::string shadow_ = "auto";
+  bool shadow_mode_ = false;
+  std::vector<quicklook::ShadowLook> shadow_looks_;
 
   QuickLookSettings settings_;
   std::function<void(const storage::QuickLookRecord&)> store_quicklook_;

@@ -30,9 +30,6 @@
 #include "tomorig/trigger/simulated_device.h"
 #include "tomorig/trigger/timing_plan.h"
 
-namespace tomorig::sim {
-class SimulatedRig;
-}
 namespace tomorig::trigger {
 class TriggerDevice;
 struct TriggerEvent;
@@ -42,6 +39,8 @@ class AravisCamera;
 }
 
 namespace tomorig::rig {
+
+class SimulatedScene;
 
 // What to do when a camera vanishes mid-run.
 enum class CameraLossPolicy : std::uint8_t {
@@ -136,7 +135,7 @@ class RigAcquisition {
   RigAcquisitionOptions options_;
   std::vector<std::string> camera_ids_;
   std::vector<storage::SessionCamera> session_cameras_;
-  std::unique_ptr<sim::SimulatedRig> simulator_;
+  std::unique_ptr<SimulatedScene> simulator_;  // the simulated cameras' scene (simulated_scene.h)
   std::unique_ptr<trigger::TriggerDevice> device_;
   std::unique_ptr<acquisition::FrameSetAssembler> assembler_;
   std::vector<std::unique_ptr<acquisition::Camera>> cameras_;

@@ -47,6 +47,9 @@ struct SprayOptions {
   // adds to the bright-field noise and the threshold of visibility: kept small, as the thesis's
   // thresholds (0.980-0.988, Sect. 7.3.3) imply.
   double pulse_jitter = 0.005;
+  // LED pulse B's mean energy relative to pulse A (1: equal). Below 1 it stands for an LED
+  // whose second pulse sags (the spray quick-look flags a 20 % drop, issue 20).
+  double pulse_b_energy = 1.0;
   bool noise = true;
   // Threads for rendering (OpenMP); 0: the default. Never changes the images.
   int threads = 0;
@@ -97,6 +100,10 @@ SprayCase make_spray_thesis_case(const SprayOptions& options);
 // The droplets of set k (positions, sizes), without images or visibility.
 std::vector<Droplet> spray_droplets(const SprayCase& c, std::uint64_t set_index);
 SpraySet render_spray_set(const SprayCase& c, std::uint64_t set_index);
+// Set k as a live rig triggers it, with an actual pulse separation `dt_ns` (jitter included):
+// the droplets keep their mid-time positions and sizes, their half-displacements scale with
+// dt_ns / the case's dt. With the case's own dt it equals render_spray_set(c, k) bit for bit.
+SpraySet render_spray_set(const SprayCase& c, std::uint64_t set_index, std::int64_t dt_ns);
 // A bright-field frame without spray (camera c, frame k of a bright-field series), with the
 // same light, pulse variation and noise: for the threshold of visibility (Sect. 6.4).
 Image render_bright_field(const SprayCase& c, std::size_t camera, std::uint64_t frame);

@@ -8,6 +8,7 @@
 #include "tomorig/processing/quicklook/drift_monitor.h"
 #include "tomorig/processing/quicklook/dt_check.h"
 #include "tomorig/processing/quicklook/preview_volume.h"
+#include "tomorig/processing/quicklook/shadow_look.h"
 #include "tomorig/processing/quicklook/statistics.h"
 
 namespace tomorig::quicklook {
@@ -18,6 +19,8 @@ void to_json(nlohmann::json& j, const TileMap& map);
 void to_json(nlohmann::json& j, const FrameStatistics& s);
 void to_json(nlohmann::json& j, const CameraQuickLook& s);
 void to_json(nlohmann::json& j, const DtCheckResult& r);
+void to_json(nlohmann::json& j, const ShadowFrame& s);
+void to_json(nlohmann::json& j, const ShadowCameraLook& s);
 void to_json(nlohmann::json& j, const DriftReport& r);
 void to_json(nlohmann::json& j, const SheetProfile& s);
 // The numbers of a preview (grid, sheet, profile, timings); the volume and projections are not

@@ -1,0 +1,140 @@
+// `tomorig run` on a spray rig file (issue 20): the live simulated rig renders the spray-thesis
+// case - the same images `tomorig simulate --case spray-thesis` writes, with the droplet truth -
+// and the quick-look switches to the spray figures, flagging an LED whose pulse B is 20 % weak.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "child_process.h"
+#include "cli_runner.h"
+#include "tomorig/storage/session_file.h"
+
+namespace tomorig::testing {
+namespace {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const fs::path kSprayRig = fs::path(TOMORIG_SOURCE_DIR) / "docs" / "examples" / "spray-thesis-rig.toml";
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The example rig with `from` replaced by `to` (a key's value), written to `out`.
+fs::path edited_rig(const fs::path& out, const std::string& from, const std::string& to) {
+  std::string text = read_text(kSprayRig);
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  std::ofstream(out) << text;
+  return out;
+}
+
+class SprayRun : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!tomorig_built()) GTEST_SKIP() << "tomorig binary not built";
+  }
+};
+
+TEST_F(SprayRun, TheLiveRigRecordsTheSprayCaseWithItsDropletTruth) {
+  TempDir dir;
+  const fs::path live = dir / "live.h5", direct = dir / "direct.h5";
+  const CliResult run = run_tomorig("run --config " + shell_quoted(kSprayRig.string()) + " --sets 2 --status none -o " +
+                                    shell_quoted(live.string()));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const CliResult sim = run_tomorig("simulate --case spray-thesis --reduced --sets 2 --seed 1 --out " +
+                                    shell_quoted(direct.string()));
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+
+  storage::SessionReader a(live), b(direct);
+  ASSERT_EQ(a.set_count(), 2u);
+  ASSERT_EQ(a.info().cameras.size(), 4u);
+  EXPECT_EQ(a.info().cameras[0].width, 640);
+  EXPECT_EQ(a.info().cameras[3].id, "cam4");
+  ASSERT_TRUE(a.has_truth());
+  EXPECT_EQ(a.truth().case_name, "spray-thesis");
+  EXPECT_EQ(a.truth().flow_name, "jet-in-crossflow");
+  const json parameters = json::parse(a.truth().flow_parameters);
+  EXPECT_NE(parameters.at("optics_setup_toml").get<std::string>().find("id = \"cam2\""), std::string::npos);
+  EXPECT_EQ(parameters.at("droplets_per_set"), 800);
+  // The rig's trigger (25 Hz, 1.7 us, no jitter) fires the case's own pulses: the frames are
+  // the simulator's, pixel for pixel, and the truth holds every droplet.
+  for (std::uint64_t s = 0; s < 2; ++s) {
+    const FrameSet live_set = a.read_set(s), direct_set = b.read_set(s);
+    EXPECT_EQ(live_set.dt_ns, 1700);
+    for (std::size_t c = 0; c < 4; ++c) {
+      EXPECT_TRUE(live_set.cameras[c].a.image.same_pixels(direct_set.cameras[c].a.image)) << s << " " << c;
+      EXPECT_TRUE(live_set.cameras[c].b.image.same_pixels(direct_set.cameras[c].b.image)) << s << " " << c;
+    }
+    ASSERT_TRUE(a.has_truth_set(s));
+    EXPECT_EQ(a.truth_set(s).particles_a.size(), 800u);
+    EXPECT_EQ(a.truth_set(s).particles_b.size(), 800u);
+  }
+}
+
+TEST_F(SprayRun, QuickLookFlagsATwentyPercentLedDropBetweenPulses) {
+  TempDir dir;
+  const fs::path rig = edited_rig(dir / "rig.toml", "pulse_b_energy = 1.0", "pulse_b_energy = 0.8");
+  const std::string endpoint = "ipc://" + (dir / "ql").string();
+  TomorigProcess preview({"preview", "--from", endpoint, "--json", "--count", "2", "--timeout", "120"});
+  ASSERT_TRUE(preview.wait_for_line("listening")) << preview.err();
+  const fs::path session = dir / "s.h5";
+  const CliResult run = run_tomorig("run --config " + shell_quoted(rig.string()) + " --sets 3 --status none --preview " +
+                                    shell_quoted(endpoint) + " -o " + shell_quoted(session.string()));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  ASSERT_EQ(preview.wait(), 0) << preview.err();
+  std::istringstream lines(preview.out());
+  std::string line;
+  int seen = 0;
+  while (std::getline(lines, line)) {
+    if (line.empty()) continue;
+    const json j = json::parse(line);
+    ++seen;
+    EXPECT_EQ(j.at("flag"), "red") << line;
+    for (const json& cam : j.at("cameras")) {
+      EXPECT_TRUE(cam.at("statistics").is_null()) << "particle statistics mean nothing on shadow images";
+      const json& shadow = cam.at("shadow");
+      EXPECT_NEAR(shadow.at("energy_ratio").at("value").get<double>(), 0.8, 0.02) << line;
+      EXPECT_EQ(shadow.at("energy_ratio").at("flag"), "red");
+      ASSERT_FALSE(shadow.at("led_energy_alarms").empty());
+      // "LED pulse B 20 % below pulse A" (19 or 21 % with the LED's pulse-to-pulse jitter).
+      const std::string alarm = shadow.at("led_energy_alarms")[0].get<std::string>();
+      EXPECT_EQ(alarm.rfind("LED pulse B ", 0), 0u) << alarm;
+      EXPECT_NE(alarm.find(" % below pulse A"), std::string::npos) << alarm;
+      // 800 droplets in the volume: a few hundred shadows deep enough to count in each view.
+      EXPECT_GT(shadow.at("a").at("shadows").at("count").get<int>(), 100);
+      EXPECT_NEAR(shadow.at("a").at("bright_field").at("fraction").get<double>(), 0.05, 0.01);
+    }
+  }
+  EXPECT_EQ(seen, 2);
+  // Stored with the session: the A/B ratio is the energy balance of /quicklook.
+  const CliResult inspect = run_tomorig("inspect --json " + shell_quoted(session.string()));
+  ASSERT_EQ(inspect.exit_code, 0) << inspect.err;
+  EXPECT_NE(inspect.out.find("energy_balance"), std::string::npos) << inspect.out.substr(0, 2000);
+}
+
+TEST_F(SprayRun, ARigTheCaseCannotRenderIsRefusedBeforeAnyFile) {
+  TempDir dir;
+  const fs::path rig = edited_rig(dir / "rig.toml", "width = 640", "width = 600");
+  const fs::path out = dir / "s.h5";
+  const CliResult run = run_tomorig("run --config " + shell_quoted(rig.string()) + " --sets 1 --status none -o " +
+                                    shell_quoted(out.string()));
+  EXPECT_EQ(run.exit_code, 2) << run.err;
+  EXPECT_NE(run.err.find("roi 600 x 540 is not a spray-thesis image"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("640 x 540"), std::string::npos) << run.err;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(dir / "s.h5.partial"));
+}
+
+}  // namespace
+}  // namespace tomorig::testing
