@@ -110,6 +110,14 @@ run_command() {
 }
 kCommands=6
 
+# One line per 100 damaged files, so that a long run shows where it is.
+damaged_files=0
+progress() {
+  damaged_files=$((damaged_files + 1))
+  ((damaged_files % 100 == 0)) || return 0
+  echo "$damaged_files damaged files, $runs runs: ok ${tally[ok]:-0}, refused ${tally[refused]:-0}, signal ${tally[signal]:-0}, timeout ${tally[timeout]:-0}, other ${tally[other]:-0}"
+}
+
 read_all() {
   if [[ $mode == rotate ]]; then
     run_command "$1" $((command_number % kCommands))
@@ -117,6 +125,7 @@ read_all() {
   else
     for ((k = 0; k < kCommands; k++)); do run_command "$1" "$k"; done
   fi
+  progress
 }
 
 # Byte `offset` of damaged.h5 with bit `bit` flipped.

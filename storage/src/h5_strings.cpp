@@ -3,6 +3,8 @@
 #include <cstring>
 #include <memory>
 
+#include <fmt/format.h>
+
 #include "h5_error.h"
 
 namespace tomorig::storage::h5 {
@@ -47,13 +49,25 @@ std::vector<std::string> read_strings(hid_t object, StringSource source, std::st
   const hssize_t points = check(H5Sget_simple_extent_npoints(space.get()), "cannot read the shape of", where);
   const auto count = static_cast<std::size_t>(points);
 
+  const bool variable = H5Tis_variable_str(stored.get()) > 0;
+  // Sized from the file before anything is allocated: a damaged extent or string size could
+  // otherwise ask for terabytes, or wrap size * count around to a small buffer that HDF5 then
+  // writes past.
+  const std::size_t element_bytes = variable ? sizeof(char*) : H5Tget_size(stored.get());
+  if (!variable && element_bytes == 0) throw Failure(std::string(where) + " has a string type of size 0");
+  if (count > kMaxStringBytes / element_bytes)
+    throw Failure(fmt::format("{} declares {} strings of {} bytes, more than the {} MiB strings of a tomorig file "
+                              "can hold: the file is damaged",
+                              where, count, variable ? std::string("variable length") : std::to_string(element_bytes),
+                              kMaxStringBytes >> 20));
+
   Datatype mem(check(H5Tcopy(H5T_C_S1), "cannot read", where));
   check(H5Tset_cset(mem.get(), H5Tget_cset(stored.get())), "cannot read", where);
   std::vector<std::string> out;
   if (count == 0) return out;  // HDF5 rejects a read into a null buffer
   out.reserve(count);
 
-  if (H5Tis_variable_str(stored.get()) > 0) {
+  if (variable) {
     check(H5Tset_size(mem.get(), H5T_VARIABLE), "cannot read", where);
     VlenBuffer buffer{std::vector<char*>(count, nullptr), mem.get(), space.get()};
     check(read_raw(object, source, mem.get(), buffer.pointers.data()), "cannot read", where);
@@ -61,8 +75,7 @@ std::vector<std::string> read_strings(hid_t object, StringSource source, std::st
     return out;
   }
 
-  const std::size_t size = H5Tget_size(stored.get());
-  if (size == 0) throw Failure(std::string(where) + " has a string type of size 0");
+  const std::size_t size = element_bytes;
   check(H5Tset_size(mem.get(), size), "cannot read", where);
   check(H5Tset_strpad(mem.get(), H5T_STR_NULLPAD), "cannot read", where);
   std::vector<char> raw(size * count, '\0');

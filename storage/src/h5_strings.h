@@ -2,6 +2,7 @@
 // The string datatypes of the session layout, shared by attributes and datasets.
 #include <hdf5.h>
 
+#include <cstddef>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -18,8 +19,14 @@ Datatype utf8_string_type();
 // heap that libhdf5 1.10 reads without bounds checks, these are read straight from the object.
 Datatype fixed_utf8_string_type(std::size_t bytes);
 
+// The most bytes the strings of one attribute or dataset may take in memory (fixed-length
+// bytes, or one pointer per variable-length string). tomorig's strings are metadata: ids, the
+// rig file, JSON parameters and reports, far below this; a damaged file may declare more.
+inline constexpr std::size_t kMaxStringBytes = std::size_t{256} << 20;
+
 // All strings held by an open attribute or dataset (`source` says which), whether stored
-// as variable- or fixed-length strings; HDF5's variable-length buffers are freed here.
+// as variable- or fixed-length strings; HDF5's variable-length buffers are freed here. Throws
+// Failure for a non-string type and for more than kMaxStringBytes, before allocating anything.
 enum class StringSource { attribute, dataset };
 std::vector<std::string> read_strings(hid_t object, StringSource source, std::string_view where);
 

@@ -272,6 +272,33 @@ TEST(SessionValidation, FramesLargerThanAChunkCanBeAreRefused) {
   expect_error([&] { SessionReader r(dir / "wide.h5"); }, ErrorKind::bad_input, {"width", "4294967312", "1 to 65536"});
 }
 
+// A string dataset declaring 2^40 strings of 1 MiB (an exabyte, stored as nothing: chunked and
+// never written): before the strings were sized against a limit, the reader asked for the whole
+// buffer and died of a bare std::bad_alloc (ASan: allocation-size-too-big), and an extent and
+// size whose product wraps around 2^64 would have had HDF5 write past a small buffer.
+TEST(SessionValidation, StringsLargerThanAFileCanHoldAreRefused) {
+  TempDir dir;
+  const fs::path path = four_camera_session(dir);
+  {
+    Edit edit(path);
+    H5Ldelete(edit.id(), "/config", H5P_DEFAULT);
+    const hid_t type = H5Tcopy(H5T_C_S1);
+    H5Tset_size(type, std::size_t{1} << 20);
+    const hsize_t dims[1] = {hsize_t{1} << 40}, max[1] = {H5S_UNLIMITED}, chunk[1] = {1};
+    const hid_t space = H5Screate_simple(1, dims, max);
+    const hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+    H5Pset_chunk(dcpl, 1, chunk);
+    const hid_t ds = H5Dcreate2(edit.id(), "/config", type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    ASSERT_GE(ds, 0);
+    H5Dclose(ds);
+    H5Pclose(dcpl);
+    H5Sclose(space);
+    H5Tclose(type);
+  }
+  expect_error([&] { SessionReader r(path); }, ErrorKind::bad_input,
+               {path.string(), "/config declares 1099511627776 strings of 1048576 bytes", "damaged"});
+}
+
 TEST(SessionValidation, FramesMarkedPresentMustBeStored) {
   TempDir dir;
   const fs::path path = dir / "s.h5";
