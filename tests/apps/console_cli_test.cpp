@@ -184,6 +184,22 @@ TEST_F(ConsoleCli, ProcessInspectAndReconstructTakeJsonFile) {
   EXPECT_TRUE(recon_summary["volumes"].contains("a")) << recon_summary.dump();
 }
 
+// Issue 23: intensity against depth as a picture (reconstruct --png), refused before any work
+// when the picture exists.
+TEST_F(ConsoleCli, ReconstructDrawsIntensityAgainstDepth) {
+  const fs::path png = *dir_ / "depth.png";
+  const std::string args = "reconstruct " + shell_quoted(session_) + " --calib truth --grid 24,24,32,0.0195 " +
+                           "--algorithm mlos --png " + shell_quoted(png.string()) + " -o ";
+  const CliResult r = run_tomorig(args + shell_quoted((*dir_ / "vd.h5").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_TRUE(fs::exists(png));
+  EXPECT_GT(fs::file_size(png), 1000u);
+  const CliResult again = run_tomorig(args + shell_quoted((*dir_ / "vd2.h5").string()));
+  EXPECT_EQ(again.exit_code, 2) << again.err;
+  EXPECT_NE(again.err.find("--overwrite"), std::string::npos) << again.err;
+  EXPECT_FALSE(fs::exists(*dir_ / "vd2.h5"));
+}
+
 // Issue 23: process said nothing inside a set (minutes on a real grid); -v logs each step.
 TEST_F(ConsoleCli, ProcessReportsTheStepsInsideASet) {
   const CliResult r = run_tomorig(process("steps.h5", "--sets 1 -v"));
