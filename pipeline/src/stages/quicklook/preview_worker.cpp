@@ -61,7 +61,9 @@ PreviewWorker::State PreviewWorker::state() const {
 }
 
 void PreviewWorker::work() {
-  if (std::string error = lower_this_thread_priority(nice_); !error.empty()) {
+  std::string error = lower_this_thread_priority(nice_);
+  if (error.empty()) error = run_this_thread_only_when_idle();
+  if (!error.empty()) {
     std::lock_guard lock(mutex_);
     state_.priority_error = std::move(error);
   }

@@ -1,5 +1,7 @@
 #include "thread_priority.h"
 
+#include <pthread.h>
+#include <sched.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -18,6 +20,14 @@ std::string lower_this_thread_priority(int nice) {
   if (current == -1 && errno != 0) return fmt::format("getpriority: {}", std::strerror(errno));
   if (current >= nice) return {};
   if (setpriority(PRIO_PROCESS, tid, nice) != 0) return fmt::format("setpriority({}): {}", nice, std::strerror(errno));
+  return {};
+}
+
+std::string run_this_thread_only_when_idle() {
+  sched_param param{};
+  param.sched_priority = 0;  // the only priority SCHED_IDLE has
+  if (const int error = pthread_setschedparam(pthread_self(), SCHED_IDLE, &param); error != 0)
+    return fmt::format("pthread_setschedparam(SCHED_IDLE): {}", std::strerror(error));
   return {};
 }
 
