@@ -31,6 +31,8 @@
 #include "tomorig/processing/calibration/calibrate_cameras.h"
 #include "tomorig/processing/calibration/fit_camera_model.h"
 #include "tomorig/processing/calibration/target_file.h"
+#include "tomorig/processing/calibration/residual_plot.h"
+#include "tomorig/storage/image_file.h"
 #include "tomorig/storage/output_path.h"
 
 namespace tomorig::app {
@@ -58,6 +60,7 @@ struct CalibrateArgs {
   bool stage_correction = false;
   std::string points_out;
   std::string overlay;  // --overlay DIR: a PNG per target image showing what was detected
+  std::string png;      // --png DIR: the stored model's residuals per camera and plane
   // Target spec (with --images / --image-list).
   std::string target = "dots";
   double spacing_mm = 0;
@@ -370,6 +373,34 @@ void run_check(const CalibrateArgs& args) {
   print_report(results, "", "");
 }
 
+// --png DIR: one picture per camera and plane, "cam<i>_z<z>mm_residuals.png".
+std::map<std::pair<int, double>, std::filesystem::path> residual_plot_files(
+    const std::string& dir, const std::vector<std::vector<calibration::PointCorrespondence>>& cameras) {
+  std::map<std::pair<int, double>, std::filesystem::path> files;
+  for (std::size_t c = 0; c < cameras.size(); ++c)
+    for (const auto& p : cameras[c])
+      files.try_emplace({static_cast<int>(c), p.world.z},
+                        std::filesystem::path(dir) / fmt::format("cam{}_z{:g}mm_residuals.png", c, p.world.z));
+  return files;
+}
+
+void write_residual_plots(const std::string& dir, const std::vector<std::vector<calibration::PointCorrespondence>>& cameras,
+                          const std::vector<calibration::CameraCalibration>& calibrations) {
+  for (const auto& [key, file] : residual_plot_files(dir, cameras)) {
+    const auto& [camera, z] = key;
+    const auto stored = std::find_if(calibrations.begin(), calibrations.end(),
+                                     [camera = camera](const auto& c) { return c.id == camera; });
+    if (stored == calibrations.end()) continue;
+    std::vector<calibration::PointCorrespondence> plane;
+    for (const auto& p : cameras[static_cast<std::size_t>(camera)])
+      if (p.world.z == z) plane.push_back(p);
+    const calibration::ResidualPlot plot = calibration::residual_plot(
+        *stored->model, plane, stored->image_size, fmt::format("camera {}, plane z = {:g} mm, {}", camera, z, stored->report.model));
+    storage::write_png(file, plot.image);
+  }
+  fmt::print(stderr, "residual plots in {}\n", dir);
+}
+
 void run(const CalibrateArgs& args) {
   if (!args.check.empty()) return run_check(args);
   if (args.out.empty()) throw bad_input("-o,--out CALIB.toml is required: the calibration file to write");
@@ -405,11 +436,18 @@ void run(const CalibrateArgs& args) {
   options.notice = [](const std::string& text) { fmt::print(stderr, "{}\n", text); };
   const Inputs in = read_inputs(args);
   options.camera_names = in.camera_names;
+  if (!args.png.empty()) {  // before any fit: no picture is replaced without --overwrite
+    std::error_code ec;
+    std::filesystem::create_directories(args.png, ec);
+    for (const auto& [key, file] : residual_plot_files(args.png, in.table.cameras))
+      storage::check_output_path(file.string(), args.overwrite, "residual plot");
+  }
 
   const calibration::CalibrateCamerasReport result = calibration::calibrate_cameras(in.table.cameras, in.sizes, options);
   // Nothing is written unless the stored model fitted every camera.
   if (!result.stored_failure) calibration::save_calibration(args.out, result.calibrations);
   for (const std::string& warning : result.poor_fit_warnings()) fmt::print(stderr, "warning: {}\n", warning);
+  if (!args.png.empty() && !result.stored_failure) write_residual_plots(args.png, in.table.cameras, result.calibrations);
   const std::string written = result.stored_failure ? std::string() : args.out;
   if (args.json.wanted()) {
     nlohmann::json j = json_summary("calibrate");
@@ -470,6 +508,9 @@ void add_calibrate_command(CLI::App& root) {
                   "Fewest target points an image must yield; fewer is an error naming camera and plane")
       ->capture_default_str();
   cmd->add_option("--points-out", args->points_out, "Also write the detected points as a correspondence CSV");
+  cmd->add_option("--png", args->png,
+                  "Write DIR/cam<i>_z<z>mm_residuals.png per camera and plane: each point with an arrow to where the "
+                  "stored model projects it, magnified (existing files need --overwrite)");
   cmd->add_option("--overlay", args->overlay,
                   "Target images: write DIR/cam<i>_<z>mm.png per image, the detected points circled, the origin ringed "
                   "and the +x, +y axes drawn (existing files need --overwrite)");

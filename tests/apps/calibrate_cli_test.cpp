@@ -19,6 +19,7 @@
 #include "tomorig/processing/calibration/calibration_file.h"
 #include "tomorig/processing/calibration/pinhole_camera.h"
 #include "tomorig/simulators/window_view.h"
+#include "tomorig/storage/image_file.h"
 #include "tomorig/storage/session_file.h"
 
 namespace tomorig::testing {
@@ -133,6 +134,35 @@ TEST_F(CalibrateCli, AnExistingCalibrationIsReplacedOnlyWithOverwrite) {
                                          shell_quoted(out.string()));
   ASSERT_EQ(replaced.exit_code, 0) << replaced.err;
   EXPECT_EQ(calibration::load_calibration(out.string()).size(), 2u);
+}
+
+// Issue 23: --png DIR draws the stored model's residuals per camera and plane; an existing
+// picture is refused before any fit (nothing written) and replaced with --overwrite.
+TEST_F(CalibrateCli, ResidualPicturesPerCameraAndPlaneAreNeverReplacedWithoutOverwrite) {
+  const std::string points = write_points(csv_rows(stereo_pair(), {-2, 0, 2}, 10, 6));
+  const auto pictures = dir_ / "residuals";
+  const auto out = dir_ / "calib.toml";
+  const std::string args = "calibrate --points " + points + " --models pinhole --image-size 512,512 --png " +
+                           shell_quoted(pictures.string()) + " -o ";
+  const CliResult r = run_tomorig(args + shell_quoted(out.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (int camera : {0, 1})
+    for (const char* z : {"-2", "0", "2"}) {
+      const auto file = pictures / fmt::format("cam{}_z{}mm_residuals.png", camera, z);
+      ASSERT_TRUE(std::filesystem::exists(file)) << file;
+      const Image picture = storage::read_image(file);
+      EXPECT_EQ(picture.width(), 512) << file;
+      EXPECT_EQ(picture.height(), 552) << file;
+    }
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(pictures), std::filesystem::directory_iterator()), 6);
+
+  const auto second = dir_ / "second.toml";
+  const CliResult refused = run_tomorig(args + shell_quoted(second.string()));
+  EXPECT_EQ(refused.exit_code, 2) << refused.err;
+  EXPECT_NE(refused.err.find("--overwrite"), std::string::npos) << refused.err;
+  EXPECT_FALSE(std::filesystem::exists(second)) << "refused before any fit";
+  const CliResult replaced = run_tomorig(args + shell_quoted(second.string()) + " --overwrite");
+  EXPECT_EQ(replaced.exit_code, 0) << replaced.err;
 }
 
 TEST_F(CalibrateCli, BadInputIsAnErrorNamingTheCameraOrTheLine) {
