@@ -91,7 +91,8 @@ void summarise(const storage::EnsembleStatistics& stats, BackendReport& report) 
 void draw_mean_slice(const storage::EnsembleStatistics& stats, const fs::path& png) {
   std::vector<bool> counted(stats.valid_count.size());
   for (std::size_t i = 0; i < counted.size(); ++i) counted[i] = stats.valid_count[i] > 0;
-  write_slice_png(png, stats.nx, stats.ny, stats.nz, stats.nz / 2, stats.mean_displacement_voxel, counted);
+  write_slice_png(png, stats.nx, stats.ny, stats.nz, stats.nz / 2, stats.mean_displacement_voxel, counted, stats.origin,
+                  stats.spacing);
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 #include "tomorig/pipeline/backend.h"
 #include "tomorig/pipeline/stage_registry.h"
 #include "tomorig/rig/simulate_session.h"
+#include "tomorig/storage/image_file.h"
 #include "tomorig/storage/results_file.h"
 #include "tomorig/storage/session_file.h"
 
@@ -58,8 +59,13 @@ TEST_F(Backend, OverlappedAndSequentialRunsWriteTheSameField) {
   EXPECT_EQ(a.sets_processed, 2u);
   EXPECT_GT(a.mean_valid_fraction, 0.3);  // a sanity check: accuracy against the flow is process_cli_test's
 
-  const pipeline::BackendReport b = pipeline::run_backend(session(), options(*dir_ / "overlapped.h5"));
+  pipeline::BackendOptions overlapped = options(*dir_ / "overlapped.h5");
+  overlapped.png = *dir_ / "mean-slice.png";  // the mean field's middle z-slice, axes in mm
+  const pipeline::BackendReport b = pipeline::run_backend(session(), overlapped);
   EXPECT_EQ(b.sets_in_file, 2u);
+  const Image slice = storage::read_image(overlapped.png);
+  EXPECT_GT(slice.width(), 200);
+  EXPECT_GT(slice.height(), 200);
   const storage::ResultsReader ra(a.out), rb(b.out);
   for (std::uint64_t s = 0; s < 2; ++s) {
     const VectorField fa = ra.read_set(s).field, fb = rb.read_set(s).field;
