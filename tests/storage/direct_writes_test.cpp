@@ -59,6 +59,13 @@ void expect_sets_intact(const SessionReader& reader, std::uint64_t sets) {
   }
 }
 
+SessionInfo session_info() {
+  SessionInfo info;
+  info.cameras = kCameras;
+  info.rig_config_toml = "name = \"direct writes\"\n";
+  return info;
+}
+
 bool folder_takes_direct_io(const fs::path& folder) {
   const fs::path probe = folder / "direct-io-probe";
   const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_DIRECT, 0644);
@@ -71,15 +78,12 @@ bool folder_takes_direct_io(const fs::path& folder) {
 TEST(DirectWrites, LiveSessionReadsBackBitIdenticalWhileRecordedAndAfter) {
   TempDir dir;
   const fs::path out = dir / "live.h5";
-  SessionInfo info;
-  info.cameras = kCameras;
-  info.rig_config_toml = "name = \"direct writes\"\n";
   SessionWriterOptions options;
   options.live = true;
   options.flush.every_sets = 1;
   const std::size_t direct_before = direct_bytes_written();
   {
-    SessionWriter writer(out, info, options);
+    SessionWriter writer(out, session_info(), options);
     for (std::uint64_t k = 0; k < 3; ++k) writer.append(set_to_write(k));
     // A reader with HDF5's default driver, during the recording.
     expect_sets_intact(SessionReader(writer.partial_path()), 3);
@@ -99,13 +103,10 @@ TEST(DirectWrites, LiveSessionReadsBackBitIdenticalWhileRecordedAndAfter) {
 TEST(DirectWrites, FinishedSessionWithCompressionReadsBackBitIdentical) {
   TempDir dir;
   const fs::path out = dir / "compressed.h5";
-  SessionInfo info;
-  info.cameras = kCameras;
-  info.rig_config_toml = "name = \"direct writes\"\n";
   SessionWriterOptions options;
   options.compression = Compression::bitshuffle_lz4;
   {
-    SessionWriter writer(out, info, options);
+    SessionWriter writer(out, session_info(), options);
     for (std::uint64_t k = 0; k < 3; ++k) writer.append(set_to_write(k));
     writer.finish();
   }
