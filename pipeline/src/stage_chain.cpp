@@ -1,7 +1,9 @@
 #include "tomorig/pipeline/stage_chain.h"
 
 #include <chrono>
+#include <algorithm>
 #include <condition_variable>
+#include <deque>
 #include <exception>
 #include <mutex>
 #include <optional>
@@ -30,10 +32,12 @@ struct StageRunner::Impl {
   StageReport report;
   bool skipping = false;
 
-  // The worker of a skipping stage and its one-set mailbox.
+  // The worker of a skipping stage and the sets waiting for it (oldest first, at most
+  // max_waiting; they share the pixel buffers, so a waiting set costs no copy).
   std::mutex mutex;
   std::condition_variable changed;
-  std::optional<FrameSet> mailbox;
+  std::deque<FrameSet> waiting;
+  std::size_t max_waiting = 1;
   bool busy = false;
   bool closing = false;
   bool failed = false;
@@ -58,10 +62,10 @@ struct StageRunner::Impl {
   void work() {
     std::unique_lock lock(mutex);
     for (;;) {
-      changed.wait(lock, [&] { return mailbox.has_value() || closing; });
-      if (!mailbox) return;  // closing and drained
-      FrameSet set = std::move(*mailbox);
-      mailbox.reset();
+      changed.wait(lock, [&] { return !waiting.empty() || closing; });
+      if (waiting.empty()) return;  // closing and drained
+      FrameSet set = std::move(waiting.front());
+      waiting.pop_front();
       busy = true;
       lock.unlock();
       const bool ok = run_one(set);
@@ -69,8 +73,8 @@ struct StageRunner::Impl {
       busy = false;
       if (!ok) {
         failed = true;
-        if (mailbox) ++report.skipped;  // never processed: the stage stopped
-        mailbox.reset();
+        report.skipped += waiting.size();  // never processed: the stage stopped
+        waiting.clear();
         return;
       }
     }
@@ -80,6 +84,7 @@ struct StageRunner::Impl {
 StageRunner::StageRunner(std::string name, std::unique_ptr<Stage> stage) : impl_(std::make_unique<Impl>()) {
   impl_->report.name = std::move(name);
   impl_->skipping = stage->may_skip();
+  impl_->max_waiting = std::max<std::size_t>(1, stage->max_waiting_sets());
   impl_->stage = std::move(stage);
 }
 
@@ -88,7 +93,7 @@ StageRunner::~StageRunner() {
     {
       std::lock_guard lock(impl_->mutex);
       impl_->closing = true;
-      impl_->mailbox.reset();
+      impl_->waiting.clear();
     }
     impl_->changed.notify_all();
     impl_->worker.join();
@@ -114,8 +119,11 @@ void StageRunner::offer(const FrameSet& set) {
     ++s.report.skipped;
     return;
   }
-  if (s.mailbox) ++s.report.skipped;  // the waiting set is stale now: the newest replaces it
-  s.mailbox = set;                    // shares the pixel buffers; no copy of the images
+  if (s.waiting.size() >= s.max_waiting) {  // the oldest waiting set is stale now
+    s.waiting.pop_front();
+    ++s.report.skipped;
+  }
+  s.waiting.push_back(set);  // shares the pixel buffers; no copy of the images
   s.changed.notify_all();
 }
 
@@ -124,7 +132,7 @@ StageReport StageRunner::end() {
   if (s.worker.joinable()) {
     {
       std::lock_guard lock(s.mutex);
-      s.closing = true;  // the worker processes the set still waiting, then returns
+      s.closing = true;  // the worker processes the sets still waiting, then returns
     }
     s.changed.notify_all();
     s.worker.join();

@@ -10,7 +10,6 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
-#include <future>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -18,6 +17,7 @@
 #include <vector>
 
 #include "h5_error.h"
+#include "piece_writers.h"
 
 namespace tomorig::storage {
 namespace {
@@ -48,6 +48,7 @@ struct DirectFile {
   // Bounce buffers for frames whose memory is not page-aligned, one per piece.
   std::vector<AlignedBuffer> bounce;
   std::size_t bounce_bytes = 0;
+  PieceWriters writers{kPieces - 1};  // the caller writes the last piece itself
 };
 
 DirectFile* of(H5FD_t* file) { return reinterpret_cast<DirectFile*>(file); }
@@ -94,15 +95,7 @@ int write_direct(DirectFile& f, const std::byte* data, std::size_t size, off_t o
     }
     return write_all(f.direct_fd, source, n, offset + static_cast<off_t>(begin)) ? 0 : errno;
   };
-  std::vector<std::future<int>> others;
-  others.reserve(pieces - 1);
-  for (std::size_t k = 0; k + 1 < pieces; ++k) others.push_back(std::async(std::launch::async, write_piece, k));
-  int error = write_piece(pieces - 1);
-  for (auto& other : others) {
-    const int e = other.get();
-    if (error == 0) error = e;
-  }
-  return error;
+  return f.writers.run(pieces, write_piece);
 }
 
 H5FD_t* open_file(const char* name, unsigned flags, hid_t /*fapl*/, haddr_t maxaddr) {

@@ -463,7 +463,10 @@ void SessionWriter::Impl::require_disk_room() const {
 
 void SessionWriter::Impl::flush_if_due() {
   const auto now = std::chrono::steady_clock::now();
-  const bool by_count = options.flush.every_sets > 0 && sets - sets_at_last_flush >= options.flush.every_sets;
+  // Multiples of every_sets, not "every_sets after the last flush": a flush by time in between
+  // must not push the next one back (a slow start would leave set 10 unflushed at its line).
+  const bool by_count =
+      options.flush.every_sets > 0 && sets != sets_at_last_flush && sets % options.flush.every_sets == 0;
   const bool by_time = std::chrono::duration<double>(now - last_flush).count() >= options.flush.every_seconds;
   if (!by_count && !by_time) return;
   h5::check(H5Fflush(file.get(), H5F_SCOPE_LOCAL), "cannot flush", partial.path().string());

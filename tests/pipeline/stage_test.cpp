@@ -102,6 +102,7 @@ class HeldStage final : public Stage {
   std::vector<std::uint64_t> seen;
   bool ended = false;
   bool skip = true;
+  std::size_t waiting = 1;
   void configure(const StageTable&) override {}
   void process(const FrameSet& set) override {
     if (seen.empty()) {
@@ -113,6 +114,7 @@ class HeldStage final : public Stage {
   }
   void end() override { ended = true; }
   bool may_skip() const override { return skip; }
+  std::size_t max_waiting_sets() const override { return waiting; }
 };
 
 TEST(StageRunner, ASkippingStageTakesTheNewestSetAndCountsTheOthers) {
@@ -132,6 +134,24 @@ TEST(StageRunner, ASkippingStageTakesTheNewestSetAndCountsTheOthers) {
   EXPECT_EQ(report.skipped, 3u);
   EXPECT_TRUE(stage.ended);
   EXPECT_NE(report.brief().find("3 skipped"), std::string::npos) << report.brief();
+}
+
+TEST(StageRunner, AStageThatMayLagKeepsItsNewestSetsWaitingAndSkipsOnlyTheOldest) {
+  auto owned = std::make_unique<HeldStage>();
+  owned->waiting = 3;
+  HeldStage& stage = *owned;
+  std::future<void> entered = stage.entered.get_future();
+  pipeline::StageRunner runner("held", std::move(owned));
+  runner.begin({});
+  runner.offer(row_set(4, 0, 1, 1, 1));
+  entered.wait();  // set 1 is being processed
+  for (std::uint64_t t = 2; t <= 6; ++t) runner.offer(row_set(4, 0, 1, 1, t));
+  stage.release.set_value();
+  const pipeline::StageReport report = runner.end();  // the waiting sets are processed first
+  EXPECT_EQ(stage.seen, (std::vector<std::uint64_t>{1, 4, 5, 6}));  // 2 and 3 gave way, in order
+  EXPECT_EQ(report.offered, 6u);
+  EXPECT_EQ(report.processed, 4u);
+  EXPECT_EQ(report.skipped, 2u);
 }
 
 TEST(StageRunner, ALosslessStageSeesEverySetAndItsErrorsReachTheCaller) {

@@ -67,6 +67,10 @@ class Stage {
   virtual nlohmann::json status() const { return nlohmann::json::object(); }
   // True: the stage may skip sets to stay current; false: it sees every set.
   virtual bool may_skip() const { return false; }
+  // A skipping stage: how many sets may wait for it before the oldest waiting one is skipped.
+  // 1 keeps only the newest (a preview that must be current); a few let a stage that is fast
+  // enough on average ride out a slow moment (a cold cache, a scheduler hiccup) without a skip.
+  virtual std::size_t max_waiting_sets() const { return 1; }
 };
 
 // What a StageRunner reports about its stage.

@@ -4,8 +4,9 @@
 //
 // A stage that sees every set runs in the caller's thread, so a slow one slows the source
 // (back-pressure, never loss); an error it throws reaches the caller. A stage that may skip
-// runs on its own thread behind a one-set mailbox: a set offered while the stage is busy
-// waits there, and a newer one replaces it (the replaced one counts as skipped). An error it
+// runs on its own thread behind a short queue (Stage::max_waiting_sets(), one set by default):
+// a set offered while the stage is busy waits there, and when the queue is full the oldest
+// waiting set gives way to the newest (it counts as skipped). An error it
 // throws stops that stage only; the report carries it, and the other stages go on.
 #include <memory>
 #include <string>
@@ -18,14 +19,14 @@ namespace tomorig::pipeline {
 class StageRunner {
  public:
   StageRunner(std::string name, std::unique_ptr<Stage> stage);
-  ~StageRunner();  // stops a worker without waiting for its mailbox
+  ~StageRunner();  // stops a worker without processing the sets still waiting
   StageRunner(const StageRunner&) = delete;
   StageRunner& operator=(const StageRunner&) = delete;
 
   void begin(const SessionDescription& recording);
   void offer(const FrameSet& set);
-  // End of acquisition: a skipping stage first processes the set waiting in its mailbox (the
-  // newest), then every stage's end() runs. Returns the report; call once.
+  // End of acquisition: a skipping stage first processes the sets still waiting for it, then
+  // every stage's end() runs. Returns the report; call once.
   StageReport end();
   const std::string& name() const;
 

@@ -40,6 +40,8 @@
 namespace tomorig::pipeline {
 namespace {
 
+constexpr std::size_t kStatisticsMayLagSets = 5;
+
 using namespace quicklook_stage;
 using Clock = std::chrono::steady_clock;
 
@@ -249,6 +251,11 @@ class QuickLookStage final : public Stage {
   }
 
   bool may_skip() const override { return true; }
+  // The statistics keep up with the rig on average (docs/performance.md, "Quick-look") but not
+  // in every moment: the first sets after a start meet cold caches, and the recorder's writes
+  // take the cores in bursts. Half a second of sets at 10 Hz may wait, so such a moment costs
+  // a little latency instead of skipped statistics; the preview volume keeps only the newest.
+  std::size_t max_waiting_sets() const override { return kStatisticsMayLagSets; }
 
  private:
   // A recording of a shadowgraphy rig: the spray-thesis simulation, or a rig whose light

@@ -82,9 +82,11 @@ struct SetRecord {
 
 // SessionInfo::software_version and created_utc are filled in by the writer when empty;
 // SessionInfo::compression is ignored on writing (the options decide).
-// When a live recording makes its sets visible and durable (HDF5 flush): after `every_sets`
-// sets or `every_seconds` since the last flush, whichever comes first. A flush costs a few
-// metadata writes; after a crash or SIGKILL, every set before the last flush is intact.
+// When a live recording makes its sets visible and durable (HDF5 flush): when the set count
+// reaches a multiple of `every_sets` (sets 10, 20, ... by default, whatever the clock did in
+// between, so "set 10 is on disk" holds at set 10), and whenever `every_seconds` passed since
+// the last flush. A flush costs a few metadata writes; after a crash or SIGKILL, every set
+// before the last flush is intact.
 struct FlushPolicy {
   std::uint64_t every_sets = 10;
   double every_seconds = 1.0;
