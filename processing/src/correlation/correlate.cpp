@@ -201,7 +201,7 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
       // Every window's lag sums at once, shared between the overlapping windows. (The windows
       // of a deformation pass start at node * step, all inside the volumes.)
       const auto start_sums = std::chrono::steady_clock::now();
-      detail::window_lag_sums(va, vb, occupied_a.threshold, occupied_b.threshold, g.window, g.step, g.nodes,
+      detail::window_lag_sums(occupied_a, vb, occupied_b, g.window, g.step, g.nodes,
                               direct_correlator->weights_x(), direct_correlator->weights_y(),
                               direct_correlator->weights_z(), threads, level.lag_sums);
       seconds_lag_sums = seconds_since(start_sums);

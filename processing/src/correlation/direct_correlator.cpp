@@ -42,7 +42,6 @@ void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, in
 #pragma omp parallel for num_threads(threads) reduction(max : largest) schedule(static)
   for (long long n = 0; n < static_cast<long long>(voxels); ++n) largest = std::max(largest, std::abs(v.data[n]));
   const float threshold = relative_threshold * largest;
-  o.threshold = threshold;
   std::vector<std::size_t>& counts = o.offsets;  // counts, then their running sum, then fill cursors
   counts.assign(block_count + 1, 0);
   auto block_of = [&](int x, int y, int z) {
@@ -51,25 +50,37 @@ void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, in
   };
   // Each block-slab of z is one iteration, so every block is counted and filled by one thread,
   // in scan order: the lists do not depend on the thread count.
+  const std::size_t row_count = static_cast<std::size_t>(v.ny) * v.nz;
+  o.row_offsets.assign(row_count + 1, 0);
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
   for (int bz = 0; bz < o.blocks.z; ++bz)
     for (int z = bz * block.z; z < std::min(v.nz, (bz + 1) * block.z); ++z)
       for (int y = 0; y < v.ny; ++y) {
         const float* row = v.data + v.linear(0, y, z);
+        std::size_t in_row = 0;
         for (int x = 0; x < v.nx; ++x)
-          if (std::abs(row[x]) > threshold) ++counts[block_of(x, y, z) + 1];
+          if (std::abs(row[x]) > threshold) {
+            ++counts[block_of(x, y, z) + 1];
+            ++in_row;
+          }
+        o.row_offsets[y + static_cast<std::size_t>(v.ny) * z + 1] = in_row;
       }
   for (std::size_t b = 0; b < block_count; ++b) counts[b + 1] += counts[b];
+  for (std::size_t r = 0; r < row_count; ++r) o.row_offsets[r + 1] += o.row_offsets[r];
   o.entries.resize(counts[block_count]);
+  o.row_entries.resize(counts[block_count]);
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
   for (int bz = 0; bz < o.blocks.z; ++bz)
     for (int z = bz * block.z; z < std::min(v.nz, (bz + 1) * block.z); ++z)
       for (int y = 0; y < v.ny; ++y) {
         const float* row = v.data + v.linear(0, y, z);
+        OccupiedVoxels::RowEntry* in_row = o.row_entries.data() + o.row_offsets[y + static_cast<std::size_t>(v.ny) * z];
         for (int x = 0; x < v.nx; ++x)
-          if (std::abs(row[x]) > threshold)
+          if (std::abs(row[x]) > threshold) {
             o.entries[counts[block_of(x, y, z)]++] = {static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y),
                                                       static_cast<std::uint16_t>(z), row[x]};
+            *in_row++ = {x, row[x]};
+          }
       }
   // The fill advanced each block's start to the next block's: shift back by one block.
   for (std::size_t b = block_count; b > 0; --b) counts[b] = counts[b - 1];

@@ -19,17 +19,24 @@
 namespace tomorig::piv::detail {
 
 // Voxels whose magnitude exceeds `relative_threshold` times the volume's largest magnitude,
-// bucketed in blocks of `block` voxels per axis (scan order inside a block).
+// bucketed in blocks of `block` voxels per axis (scan order inside a block), and by row.
 struct OccupiedVoxels {
   struct Entry {
     std::uint16_t x, y, z;
     float value;
   };
+  struct RowEntry {
+    int x;
+    float value;
+  };
   Int3 block, blocks;                 // block size, block counts per axis
   std::vector<std::size_t> offsets;   // blocks + 1 offsets into entries
   std::vector<Entry> entries;
+  // The same voxels by row (y, z), x ascending: row r = y + ny z holds
+  // row_entries[row_offsets[r] .. row_offsets[r + 1]).
+  std::vector<std::size_t> row_offsets;
+  std::vector<RowEntry> row_entries;
   double occupied_fraction = 0;       // entries / voxels
-  float threshold = 0;                // the magnitude a voxel exceeds to be listed
 };
 // Fills `out`, reusing its memory (one list per volume for a whole correlation).
 void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, int threads, OccupiedVoxels& out);

@@ -34,10 +34,10 @@ void weight_table(const std::vector<float>& w, int axis, std::vector<float>& tab
   }
 }
 
-// One thread's entries of the current row: positions and their slot values.
+// One thread's slot values of the current row's entries (kSlotsA per A entry, kSlotsB per B
+// entry); they grow to the longest row's and are reused.
 struct RowEntries {
-  std::vector<int> xa, xb;
-  std::vector<float> va, vb;  // kSlotsA per A entry, kSlotsB per B entry
+  std::vector<float> va, vb;
 };
 
 struct Geometry {
@@ -49,73 +49,72 @@ struct Geometry {
 // Row y of plane z: every window ix0..ix1 - 1 along x gets its row sum (slot values times the x
 // weights), or is marked unused when no entry of the row lies in it.
 [[gnu::target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")]] void row_sums(
-    const VolumeView& a, const VolumeView& b, float threshold_a, float threshold_b, const Geometry& g, int y, int z,
+    const OccupiedVoxels& oa, const VolumeView& b, const OccupiedVoxels& ob, const Geometry& g, int y, int z,
     const float* table_x, RowEntries& e, float* rows, std::uint8_t* used) {
-  const float* ra = a.data + a.linear(0, y, z);
-  const float* rb = b.data + b.linear(0, y, z);
-  e.xa.clear();
-  e.xb.clear();
-  e.va.clear();
-  e.vb.clear();
-  const bool lags_inside = y >= 1 && y + 1 < a.ny && z >= 1 && z + 1 < a.nz;
-  const std::size_t sy = static_cast<std::size_t>(b.nx), sz = sy * static_cast<std::size_t>(b.ny);
   const int x_begin = g.ix0 * g.step.x, x_end = (g.ix1 - 1) * g.step.x + g.window.x;
-  for (int x = x_begin; x < x_end; ++x) {
-    const float av = ra[x];
-    if (std::abs(av) > threshold_a) {
-      e.xa.push_back(x);
-      const std::size_t base = e.va.size();
-      e.va.resize(base + kSlotsA);
-      float* v = e.va.data() + base;
-      if (lags_inside && x >= 1 && x + 1 < a.nx) {
-        // The 27 lag products A(x) B(x + s), B read dense.
-        const float* centre = b.data + b.linear(x, y, z);
-        for (int dz = -1; dz <= 1; ++dz)
-          for (int dy = -1; dy <= 1; ++dy) {
-            const float* row = centre + dz * static_cast<std::ptrdiff_t>(sz) + dy * static_cast<std::ptrdiff_t>(sy);
-            float* out = v + kSlotP + 3 * ((dy + 1) + 3 * (dz + 1));
-            out[0] = av * row[-1];
-            out[1] = av * row[0];
-            out[2] = av * row[1];
+  // This row's entries of a and b within the slab's x range.
+  const std::size_t row = y + static_cast<std::size_t>(b.ny) * z;
+  const OccupiedVoxels::RowEntry* first_a = oa.row_entries.data() + oa.row_offsets[row];
+  const OccupiedVoxels::RowEntry* last_a = oa.row_entries.data() + oa.row_offsets[row + 1];
+  const OccupiedVoxels::RowEntry* first_b = ob.row_entries.data() + ob.row_offsets[row];
+  const OccupiedVoxels::RowEntry* last_b = ob.row_entries.data() + ob.row_offsets[row + 1];
+  while (first_a < last_a && first_a->x < x_begin) ++first_a;
+  while (last_a > first_a && (last_a - 1)->x >= x_end) --last_a;
+  while (first_b < last_b && first_b->x < x_begin) ++first_b;
+  while (last_b > first_b && (last_b - 1)->x >= x_end) --last_b;
+  const std::size_t na = static_cast<std::size_t>(last_a - first_a), nb = static_cast<std::size_t>(last_b - first_b);
+  if (e.va.size() < na * kSlotsA) e.va.resize(na * kSlotsA);
+  if (e.vb.size() < nb * kSlotsB) e.vb.resize(nb * kSlotsB);
+  const bool lags_inside = y >= 1 && y + 1 < b.ny && z >= 1 && z + 1 < b.nz;
+  const std::size_t sy = static_cast<std::size_t>(b.nx), sz = sy * static_cast<std::size_t>(b.ny);
+  for (std::size_t n = 0; n < na; ++n) {
+    const int x = first_a[n].x;
+    const float av = first_a[n].value;
+    float* v = e.va.data() + n * kSlotsA;
+    if (lags_inside && x >= 1 && x + 1 < b.nx) {
+      // The 27 lag products A(x) B(x + s), B read dense.
+      const float* centre = b.data + b.linear(x, y, z);
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy) {
+          const float* r = centre + dz * static_cast<std::ptrdiff_t>(sz) + dy * static_cast<std::ptrdiff_t>(sy);
+          float* out = v + kSlotP + 3 * ((dy + 1) + 3 * (dz + 1));
+          out[0] = av * r[-1];
+          out[1] = av * r[0];
+          out[2] = av * r[1];
+        }
+    } else {
+      // On the volume's faces: the lags outside the volume wrap in every window holding the
+      // voxel (their P weight is 0); 0 stands in for them.
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int xx = x + dx, yy = y + dy, zz = z + dz;
+            const bool in = xx >= 0 && yy >= 0 && zz >= 0 && xx < b.nx && yy < b.ny && zz < b.nz;
+            v[kSlotP + (dx + 1) + 3 * ((dy + 1) + 3 * (dz + 1))] = in ? av * b.data[b.linear(xx, yy, zz)] : 0.0f;
           }
-      } else {
-        // On the volume's faces: the lags outside the volume wrap in every window holding the
-        // voxel (their P weight is 0); 0 stands in for them.
-        for (int dz = -1; dz <= 1; ++dz)
-          for (int dy = -1; dy <= 1; ++dy)
-            for (int dx = -1; dx <= 1; ++dx) {
-              const int xx = x + dx, yy = y + dy, zz = z + dz;
-              const bool in = xx >= 0 && yy >= 0 && zz >= 0 && xx < b.nx && yy < b.ny && zz < b.nz;
-              v[kSlotP + (dx + 1) + 3 * ((dy + 1) + 3 * (dz + 1))] = in ? av * b.data[b.linear(xx, yy, zz)] : 0.0f;
-            }
-      }
-      std::fill(v + kSlotQA, v + kSlotQA + 27, av);
-      v[kSlotSumA] = av;
-      v[kSlotW2A] = av;
-      v[kSlotW2A2] = av * av;
-      std::fill(v + kSlotW2A2 + 1, v + kSlotsA, 0.0f);
     }
-    const float bv = rb[x];
-    if (std::abs(bv) > threshold_b) {
-      e.xb.push_back(x);
-      const std::size_t base = e.vb.size();
-      e.vb.resize(base + kSlotsB);
-      float* v = e.vb.data() + base;
-      std::fill(v, v + 27, bv);
-      v[kSlotSumB - kSlotQB] = bv;
-      v[kSlotW2B - kSlotQB] = bv;
-      v[kSlotW2B2 - kSlotQB] = bv * bv;
-      std::fill(v + (kSlotW2B2 - kSlotQB) + 1, v + kSlotsB, 0.0f);
-    }
+    for (int l = 0; l < 27; ++l) v[kSlotQA + l] = av;
+    v[kSlotSumA] = av;
+    v[kSlotW2A] = av;
+    v[kSlotW2A2] = av * av;
+    for (int l = kSlotW2A2 + 1; l < kSlotsA; ++l) v[l] = 0.0f;
   }
-  const std::size_t na = e.xa.size(), nb = e.xb.size();
+  for (std::size_t n = 0; n < nb; ++n) {
+    const float bv = first_b[n].value;
+    float* v = e.vb.data() + n * kSlotsB;
+    for (int l = 0; l < 27; ++l) v[l] = bv;
+    v[kSlotSumB - kSlotQB] = bv;
+    v[kSlotW2B - kSlotQB] = bv;
+    v[kSlotW2B2 - kSlotQB] = bv * bv;
+    for (int l = kSlotW2B2 - kSlotQB + 1; l < kSlotsB; ++l) v[l] = 0.0f;
+  }
   std::size_t lo_a = 0, hi_a = 0, lo_b = 0, hi_b = 0;
   for (int ix = g.ix0; ix < g.ix1; ++ix) {
     const int x0 = ix * g.step.x, x1 = x0 + g.window.x;
-    while (lo_a < na && e.xa[lo_a] < x0) ++lo_a;
-    while (hi_a < na && e.xa[hi_a] < x1) ++hi_a;
-    while (lo_b < nb && e.xb[lo_b] < x0) ++lo_b;
-    while (hi_b < nb && e.xb[hi_b] < x1) ++hi_b;
+    while (lo_a < na && first_a[lo_a].x < x0) ++lo_a;
+    while (hi_a < na && first_a[hi_a].x < x1) ++hi_a;
+    while (lo_b < nb && first_b[lo_b].x < x0) ++lo_b;
+    while (hi_b < nb && first_b[hi_b].x < x1) ++hi_b;
     const std::size_t r = static_cast<std::size_t>(ix - g.ix0) * g.y_end + y;
     if (lo_a >= hi_a && lo_b >= hi_b) {
       used[r] = 0;
@@ -125,13 +124,13 @@ struct Geometry {
     alignas(64) float acc[kLagSlots] = {};
     for (std::size_t n = lo_a; n < hi_a; ++n) {
       const float* v = e.va.data() + n * kSlotsA;
-      const float* w = table_x + static_cast<std::size_t>(e.xa[n] - x0) * kLagSlots;
+      const float* w = table_x + static_cast<std::size_t>(first_a[n].x - x0) * kLagSlots;
 #pragma omp simd
       for (int l = 0; l < kSlotsA; ++l) acc[l] += v[l] * w[l];
     }
     for (std::size_t n = lo_b; n < hi_b; ++n) {
       const float* v = e.vb.data() + n * kSlotsB;
-      const float* w = table_x + static_cast<std::size_t>(e.xb[n] - x0) * kLagSlots + kSlotQB;
+      const float* w = table_x + static_cast<std::size_t>(first_b[n].x - x0) * kLagSlots + kSlotQB;
 #pragma omp simd
       for (int l = 0; l < kSlotsB; ++l) acc[kSlotQB + l] += v[l] * w[l];
     }
@@ -173,7 +172,7 @@ struct Geometry {
 
 }  // namespace
 
-void window_lag_sums(const VolumeView& a, const VolumeView& b, float threshold_a, float threshold_b, Int3 window,
+void window_lag_sums(const OccupiedVoxels& oa, const VolumeView& b, const OccupiedVoxels& ob, Int3 window,
                      Int3 step, Int3 nodes, const std::vector<float>& wx, const std::vector<float>& wy,
                      const std::vector<float>& wz, int threads, WindowLagSums& out) {
   const Geometry whole{window, step, nodes, (nodes.y - 1) * step.y + window.y, (nodes.z - 1) * step.z + window.z, 0,
@@ -212,7 +211,7 @@ void window_lag_sums(const VolumeView& a, const VolumeView& b, float threshold_a
       g.ix1 = std::min(nodes.x, g.ix0 + slab);
       for (int z = 0; z < g.z_end; ++z) {
         for (int y = 0; y < g.y_end; ++y)
-          row_sums(a, b, threshold_a, threshold_b, g, y, z, table_x.data(), entries, rows.data(), used.data());
+          row_sums(oa, b, ob, g, y, z, table_x.data(), entries, rows.data(), used.data());
         for (long long c = 0; c < columns_per_plane; ++c)
           for (int ix = g.ix0; ix < g.ix1; ++ix)
             column_sums(g, ix, static_cast<int>(c), z, rows.data(), used.data(), table_y.data(), table_z.data(), sums);

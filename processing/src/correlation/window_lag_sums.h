@@ -14,11 +14,11 @@
 //  - QA(s) = sum w(x) A(x) w(x (+) s) and QB(s) = sum w(y) B(y) w(y (-) s), circular (only the
 //    weights wrap, so the whole window separates);
 //  - sum A, sum w^2 A, sum w^2 A^2 and the same of B (means and energies).
-// A and B count where their magnitude exceeds their occupancy threshold, as the entry lists of
-// list_occupied; the B of the lag products is read dense, as the per-window path reads it.
+// A and B count where listed by list_occupied; the B of the lag products is read dense.
 #include <cstdint>
 #include <vector>
 
+#include "correlation/direct_correlator.h"
 #include "correlation/volume_view.h"
 
 namespace tomorig::piv::detail {
@@ -38,9 +38,9 @@ struct WindowLagSums {
 };
 
 // Windows of `window` voxels at node * `step` (all inside the volumes), `nodes` per axis;
-// wx/wy/wz the per-axis weights (the FFT path's), thresholds the occupancy thresholds of a and
-// b in absolute value.
-void window_lag_sums(const VolumeView& a, const VolumeView& b, float threshold_a, float threshold_b, Int3 window,
+// oa/ob the occupied voxels of a and b (their rows), b the dense volume read at the lags;
+// wx/wy/wz the per-axis weights (the FFT path's).
+void window_lag_sums(const OccupiedVoxels& oa, const VolumeView& b, const OccupiedVoxels& ob, Int3 window,
                      Int3 step, Int3 nodes, const std::vector<float>& wx, const std::vector<float>& wy,
                      const std::vector<float>& wz, int threads, WindowLagSums& out);
 
