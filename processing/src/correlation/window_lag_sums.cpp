@@ -10,6 +10,10 @@ namespace {
 
 // Slots an A entry touches (P, QA, its sums) and a B entry touches (QB, its sums).
 constexpr int kSlotsA = kSlotQB, kSlotsB = kLagSlots - kSlotQB;
+// An A entry's stored values: its 27 lag products, then A itself for the first QA slots; the
+// other slots' values are A or A^2 (the weight table is 0 in the unused slots).
+constexpr int kStoredA = 32;
+static_assert(kSlotQA == 27 && kStoredA <= kSlotSumA && kSlotsA == 2 * kStoredA && kSlotsB == 32);
 
 // Lag component of slot l (0..26) along an axis: x fastest, as lag_index.
 int lag_along(int l, int axis) { return axis == 0 ? l % 3 - 1 : axis == 1 ? (l / 3) % 3 - 1 : l / 9 - 1; }
@@ -34,10 +38,10 @@ void weight_table(const std::vector<float>& w, int axis, std::vector<float>& tab
   }
 }
 
-// One thread's slot values of the current row's entries (kSlotsA per A entry, kSlotsB per B
-// entry); they grow to the longest row's and are reused.
+// One thread's stored values of the current row's A entries (kStoredA each); they grow to the
+// longest row's and are reused.
 struct RowEntries {
-  std::vector<float> va, vb;
+  std::vector<float> va;
 };
 
 struct Geometry {
@@ -63,14 +67,13 @@ struct Geometry {
   while (first_b < last_b && first_b->x < x_begin) ++first_b;
   while (last_b > first_b && (last_b - 1)->x >= x_end) --last_b;
   const std::size_t na = static_cast<std::size_t>(last_a - first_a), nb = static_cast<std::size_t>(last_b - first_b);
-  if (e.va.size() < na * kSlotsA) e.va.resize(na * kSlotsA);
-  if (e.vb.size() < nb * kSlotsB) e.vb.resize(nb * kSlotsB);
+  if (e.va.size() < na * kStoredA) e.va.resize(na * kStoredA);
   const bool lags_inside = y >= 1 && y + 1 < b.ny && z >= 1 && z + 1 < b.nz;
   const std::size_t sy = static_cast<std::size_t>(b.nx), sz = sy * static_cast<std::size_t>(b.ny);
   for (std::size_t n = 0; n < na; ++n) {
     const int x = first_a[n].x;
     const float av = first_a[n].value;
-    float* v = e.va.data() + n * kSlotsA;
+    float* v = e.va.data() + n * kStoredA;
     if (lags_inside && x >= 1 && x + 1 < b.nx) {
       // The 27 lag products A(x) B(x + s), B read dense.
       const float* centre = b.data + b.linear(x, y, z);
@@ -93,20 +96,7 @@ struct Geometry {
             v[kSlotP + (dx + 1) + 3 * ((dy + 1) + 3 * (dz + 1))] = in ? av * b.data[b.linear(xx, yy, zz)] : 0.0f;
           }
     }
-    for (int l = 0; l < 27; ++l) v[kSlotQA + l] = av;
-    v[kSlotSumA] = av;
-    v[kSlotW2A] = av;
-    v[kSlotW2A2] = av * av;
-    for (int l = kSlotW2A2 + 1; l < kSlotsA; ++l) v[l] = 0.0f;
-  }
-  for (std::size_t n = 0; n < nb; ++n) {
-    const float bv = first_b[n].value;
-    float* v = e.vb.data() + n * kSlotsB;
-    for (int l = 0; l < 27; ++l) v[l] = bv;
-    v[kSlotSumB - kSlotQB] = bv;
-    v[kSlotW2B - kSlotQB] = bv;
-    v[kSlotW2B2 - kSlotQB] = bv * bv;
-    for (int l = kSlotW2B2 - kSlotQB + 1; l < kSlotsB; ++l) v[l] = 0.0f;
+    for (int l = kSlotQA; l < kStoredA; ++l) v[l] = av;
   }
   std::size_t lo_a = 0, hi_a = 0, lo_b = 0, hi_b = 0;
   for (int ix = g.ix0; ix < g.ix1; ++ix) {
@@ -123,16 +113,19 @@ struct Geometry {
     used[r] = 1;
     alignas(64) float acc[kLagSlots] = {};
     for (std::size_t n = lo_a; n < hi_a; ++n) {
-      const float* v = e.va.data() + n * kSlotsA;
+      const float* v = e.va.data() + n * kStoredA;
       const float* w = table_x + static_cast<std::size_t>(first_a[n].x - x0) * kLagSlots;
+      const float av = first_a[n].value, av2 = av * av;
 #pragma omp simd
-      for (int l = 0; l < kSlotsA; ++l) acc[l] += v[l] * w[l];
+      for (int l = 0; l < kStoredA; ++l) acc[l] += v[l] * w[l];
+#pragma omp simd
+      for (int l = kStoredA; l < kSlotsA; ++l) acc[l] += (l == kSlotW2A2 ? av2 : av) * w[l];
     }
     for (std::size_t n = lo_b; n < hi_b; ++n) {
-      const float* v = e.vb.data() + n * kSlotsB;
-      const float* w = table_x + static_cast<std::size_t>(first_b[n].x - x0) * kLagSlots + kSlotQB;
+      const float* w = table_x + static_cast<std::size_t>(first_b[n].x - x0) * kLagSlots;
+      const float bv = first_b[n].value, bv2 = bv * bv;
 #pragma omp simd
-      for (int l = 0; l < kSlotsB; ++l) acc[kSlotQB + l] += v[l] * w[l];
+      for (int l = kSlotQB; l < kLagSlots; ++l) acc[l] += (l == kSlotW2B2 ? bv2 : bv) * w[l];
     }
     std::copy(acc, acc + kLagSlots, rows + r * kLagSlots);
   }
