@@ -14,6 +14,7 @@
 #include "correlation/fft_correlator.h"
 #include "correlation/predictor_filters.h"
 #include "correlation/volume_deformation.h"
+#include "correlation/window_lag_sums.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/correlation/vector_validation.h"
 
@@ -34,6 +35,7 @@ struct Level {
   std::vector<std::uint8_t> support_a, support_b;  // signal_support of a and b, valid if supported
   std::vector<std::uint8_t> support_scratch;
   detail::OccupiedVoxels occupied_a, occupied_b;   // of the deformed pair, memory reused by each pass
+  detail::WindowLagSums lag_sums;                  // a direct pass's per-window sums, memory reused
 };
 
 // The buffers of a correlation, kept by the calling thread from one correlation to the next
@@ -193,7 +195,18 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
       direct = use_direct(pass, g.window, deform, pr.occupied_fraction);
     }
     std::optional<detail::DirectCorrelator> direct_correlator;
-    if (direct) direct_correlator.emplace(g.window, options.weighting, options.gaussian_sigma);
+    double seconds_lag_sums = 0;
+    if (direct) {
+      direct_correlator.emplace(g.window, options.weighting, options.gaussian_sigma);
+      // Every window's lag sums at once, shared between the overlapping windows. (The windows
+      // of a deformation pass start at node * step, all inside the volumes.)
+      const auto start_sums = std::chrono::steady_clock::now();
+      detail::window_lag_sums(occupied_a, vb, occupied_b, g.window, g.step, g.nodes,
+                              direct_correlator->weights_x(), direct_correlator->weights_y(),
+                              direct_correlator->weights_z(), threads, level.lag_sums);
+      seconds_lag_sums = seconds_since(start_sums);
+    }
+    const float* lag_sums = direct ? level.lag_sums.sums.data() : nullptr;
     pr.method = direct ? "direct" : "fft";
     const long long node_count = static_cast<long long>(field.count());
     std::size_t fallbacks = 0, empty = 0, fft_fallbacks = 0;
@@ -224,7 +237,8 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
         detail::WindowPeak peak;
         bool by_fft = !direct;
         if (direct) {
-          peak = direct_correlator->correlate(occupied_a, vb, occupied_b, start, direct_scratch, by_fft);
+          peak = direct_correlator->correlate_from_sums(lag_sums + n * detail::kLagSlots, occupied_a, vb, occupied_b,
+                                                        start, direct_scratch, by_fft);
           fft_fallbacks += by_fft;
         }
         if (by_fft) peak = correlator.correlate(va, start_a, vb, start_b, scratch);
@@ -243,7 +257,8 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
     pr.fft_fallbacks = fft_fallbacks;
     pr.seconds_windows = seconds_since(start_windows);
     pr.thread_seconds_load = load;
-    pr.thread_seconds_correlation = correlation;
+    // (The shared lag sums ran on all threads: their wall time times the threads.)
+    pr.thread_seconds_correlation = correlation + seconds_lag_sums * threads;
     pr.thread_seconds_peak = peak_fit;
     pr.empty_windows = empty;
     const auto start_validation = std::chrono::steady_clock::now();

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "correlation/window_lag_sums.h"
 #include "tomorig/processing/correlation/peak_fit.h"
 
 namespace tomorig::piv::detail {
@@ -28,11 +29,6 @@ void weight_autocorrelation(const std::vector<float>& w, double out[5]) {
   }
 }
 
-// The sums of one window's entries that Eq. 2.16 needs beside the lag products.
-struct WindowSums {
-  double sum = 0, weighted = 0, weighted_square = 0;  // sum A, sum w^2 A, sum w^2 A^2
-};
-
 inline int lag_index(int dx, int dy, int dz) { return (dx + 1) + 3 * ((dy + 1) + 3 * (dz + 1)); }
 
 }  // namespace
@@ -54,25 +50,37 @@ void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, in
   };
   // Each block-slab of z is one iteration, so every block is counted and filled by one thread,
   // in scan order: the lists do not depend on the thread count.
+  const std::size_t row_count = static_cast<std::size_t>(v.ny) * v.nz;
+  o.row_offsets.assign(row_count + 1, 0);
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
   for (int bz = 0; bz < o.blocks.z; ++bz)
     for (int z = bz * block.z; z < std::min(v.nz, (bz + 1) * block.z); ++z)
       for (int y = 0; y < v.ny; ++y) {
         const float* row = v.data + v.linear(0, y, z);
+        std::size_t in_row = 0;
         for (int x = 0; x < v.nx; ++x)
-          if (std::abs(row[x]) > threshold) ++counts[block_of(x, y, z) + 1];
+          if (std::abs(row[x]) > threshold) {
+            ++counts[block_of(x, y, z) + 1];
+            ++in_row;
+          }
+        o.row_offsets[y + static_cast<std::size_t>(v.ny) * z + 1] = in_row;
       }
   for (std::size_t b = 0; b < block_count; ++b) counts[b + 1] += counts[b];
+  for (std::size_t r = 0; r < row_count; ++r) o.row_offsets[r + 1] += o.row_offsets[r];
   o.entries.resize(counts[block_count]);
+  o.row_entries.resize(counts[block_count]);
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
   for (int bz = 0; bz < o.blocks.z; ++bz)
     for (int z = bz * block.z; z < std::min(v.nz, (bz + 1) * block.z); ++z)
       for (int y = 0; y < v.ny; ++y) {
         const float* row = v.data + v.linear(0, y, z);
+        OccupiedVoxels::RowEntry* in_row = o.row_entries.data() + o.row_offsets[y + static_cast<std::size_t>(v.ny) * z];
         for (int x = 0; x < v.nx; ++x)
-          if (std::abs(row[x]) > threshold)
+          if (std::abs(row[x]) > threshold) {
             o.entries[counts[block_of(x, y, z)]++] = {static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y),
                                                       static_cast<std::uint16_t>(z), row[x]};
+            *in_row++ = {x, row[x]};
+          }
       }
   // The fill advanced each block's start to the next block's: shift back by one block.
   for (std::size_t b = block_count; b > 0; --b) counts[b] = counts[b - 1];
@@ -104,220 +112,146 @@ DirectCorrelator::DirectCorrelator(Int3 window, WindowWeighting weighting, doubl
   weight_autocorrelation(wz_, kz_);
 }
 
-WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeView& vb, const OccupiedVoxels& ob,
-                                       Int3 start, Scratch& s, bool& fallback) const {
+WindowPeak DirectCorrelator::correlate_from_sums(const float* sums, const OccupiedVoxels& oa, const VolumeView& vb,
+                                                 const OccupiedVoxels& ob, Int3 start, Scratch& s,
+                                                 bool& fallback) const {
   fallback = false;
   WindowPeak result;
   const auto t0 = Clock::now();
   const Int3 w = window_;
   const double n = static_cast<double>(w.x) * w.y * w.z;
-  // Visits the entries of `o` inside the window: f(i, j, k, value) in window coordinates.
-  auto for_window_entries = [&](const OccupiedVoxels& o, auto&& f) {
-    const int bx0 = std::max(0, start.x) / o.block.x, bx1 = std::min(o.blocks.x - 1, (start.x + w.x - 1) / o.block.x);
-    const int by0 = std::max(0, start.y) / o.block.y, by1 = std::min(o.blocks.y - 1, (start.y + w.y - 1) / o.block.y);
-    const int bz0 = std::max(0, start.z) / o.block.z, bz1 = std::min(o.blocks.z - 1, (start.z + w.z - 1) / o.block.z);
-    for (int bz = bz0; bz <= bz1; ++bz)
-      for (int by = by0; by <= by1; ++by)
-        for (int bx = bx0; bx <= bx1; ++bx) {
-          const std::size_t b = bx + static_cast<std::size_t>(o.blocks.x) * (by + static_cast<std::size_t>(o.blocks.y) * bz);
-          // A block wholly inside the window (every block when windows start on the block
-          // grid, as the passes' do) needs no test per entry.
-          const bool whole = bx * o.block.x >= start.x && (bx + 1) * o.block.x <= start.x + w.x &&
-                             by * o.block.y >= start.y && (by + 1) * o.block.y <= start.y + w.y &&
-                             bz * o.block.z >= start.z && (bz + 1) * o.block.z <= start.z + w.z;
-          for (std::size_t e = o.offsets[b]; e < o.offsets[b + 1]; ++e) {
-            const OccupiedVoxels::Entry& v = o.entries[e];
-            const int i = v.x - start.x, j = v.y - start.y, k = v.z - start.z;
-            if (!whole && (i < 0 || j < 0 || k < 0 || i >= w.x || j >= w.y || k >= w.z)) continue;
-            f(i, j, k, v.value);
-          }
-        }
-  };
-
-  // Window a: its sums, and its entries (weighted) for the lag products.
-  WindowSums sa, sb;
-  s.a_weight.clear();
-  s.a_i.clear();
-  s.a_j.clear();
-  s.a_k.clear();
-  for_window_entries(oa, [&](int i, int j, int k, float value) {
-    const float weight = wx_[i] * wy_[j] * wz_[k];
-    const double w2 = static_cast<double>(weight) * weight;
-    sa.sum += value;
-    sa.weighted += w2 * value;
-    sa.weighted_square += w2 * value * value;
-    s.a_weight.push_back(weight * value);
-    s.a_i.push_back(static_cast<std::uint16_t>(i));
-    s.a_j.push_back(static_cast<std::uint16_t>(j));
-    s.a_k.push_back(static_cast<std::uint16_t>(k));
-  });
-  // Window b: its sums, and QB(s) = sum_y w(y) B(y) w(y - s) at the 27 lags.
-  double qb[27] = {};
-  alignas(16) float qb4[9][4] = {};  // per (dy, dz) row, x lags as 4 float lanes (the 4th unused)
-  for_window_entries(ob, [&](int i, int j, int k, float value) {
-    const float weight = wx_[i] * wy_[j] * wz_[k];
-    const double w2 = static_cast<double>(weight) * weight;
-    sb.sum += value;
-    sb.weighted += w2 * value;
-    sb.weighted_square += w2 * value * value;
-    const float wb = weight * value;
-    float py[3], pz[3];
-    alignas(16) float px[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-    for (int d = -1; d <= 1; ++d) {
-      px[d + 1] = px_[i - d + 2];
-      py[d + 1] = py_[j - d + 2];
-      pz[d + 1] = pz_[k - d + 2];
-    }
-    for (int dz = 0; dz < 3; ++dz)
-      for (int dy = 0; dy < 3; ++dy) {
-        const float f = wb * pz[dz] * py[dy];
-        float* q = qb4[dy + 3 * dz];
-#pragma omp simd
-        for (int l = 0; l < 4; ++l) q[l] += f * px[l];
-      }
-  });
-  for (int r = 0; r < 9; ++r)
-    for (int l = 0; l < 3; ++l) qb[3 * r + l] = qb4[r][l];
-  const double mean_a = sa.sum / n, mean_b = sb.sum / n;
-  // sum w^2 (A - mean)^2 over the whole window, the empty voxels included.
-  const double energy_a = sa.weighted_square - 2 * mean_a * sa.weighted + mean_a * mean_a * weight_energy_;
-  const double energy_b = sb.weighted_square - 2 * mean_b * sb.weighted + mean_b * mean_b * weight_energy_;
-  const auto t1 = Clock::now();
-  s.seconds.load += seconds_between(t0, t1);
+  const double mean_a = sums[kSlotSumA] / n, mean_b = sums[kSlotSumB] / n;
+  const double energy_a = sums[kSlotW2A2] - 2 * mean_a * sums[kSlotW2A] + mean_a * mean_a * weight_energy_;
+  const double energy_b = sums[kSlotW2B2] - 2 * mean_b * sums[kSlotW2B] + mean_b * mean_b * weight_energy_;
   if (!(energy_a > 1e-20) || !(energy_b > 1e-20)) {
     result.empty = true;
+    s.seconds.load += seconds_between(t0, Clock::now());
     return result;
   }
+  double p[27];
+  for (int l = 0; l < 27; ++l) p[l] = sums[kSlotP + l];
+  const auto t1 = Clock::now();
+  s.seconds.load += seconds_between(t0, t1);
 
-  // P(s) = sum_x w(x) A(x) w(x+s) B(x+s) and QA(s) = sum_x w(x) A(x) w(x+s), circular in the
-  // window as the FFT's correlation, B read from its volume (0 outside).
-  auto b_at = [&](int i, int j, int k) -> float {
-    const int x = start.x + i, y = start.y + j, z = start.z + k;
-    if (x < 0 || y < 0 || z < 0 || x >= vb.nx || y >= vb.ny || z >= vb.nz) return 0.0f;
-    return vb.data[vb.linear(x, y, z)];
-  };
-  double p[27] = {}, qa[27] = {};            // the edge entries, and the sums at the end
-  alignas(16) float p4[9][4] = {}, qa4[9][4] = {};  // the interior entries: per (dy, dz) row, 4 x lanes
-  const std::size_t count = s.a_weight.size();
+  // The shell: entries with a coordinate at 0 or W - 1, whose lags outward wrap around the
+  // window as the FFT's (the contraction left those pairs out of P). Blocks that hold no shell
+  // plane are skipped.
   const std::size_t sy = static_cast<std::size_t>(vb.nx), sz = sy * static_cast<std::size_t>(vb.ny);
   const bool inside = start.x >= 0 && start.y >= 0 && start.z >= 0 && start.x + w.x <= vb.nx &&
                       start.y + w.y <= vb.ny && start.z + w.z <= vb.nz;
-  for (std::size_t e = 0; e < count; ++e) {
-    const int i = s.a_i[e], j = s.a_j[e], k = s.a_k[e];
-    const float wa = s.a_weight[e];
-    float px[3], py[3], pz[3];
-    for (int d = -1; d <= 1; ++d) {
-      px[d + 1] = px_[i + d + 2];
-      py[d + 1] = py_[j + d + 2];
-      pz[d + 1] = pz_[k + d + 2];
-    }
-    // Interior: no wrap, no bounds, and the row's fourth value (weight 0) is inside the volume.
-    const bool interior = inside && i >= 1 && j >= 1 && k >= 1 && i + 2 < w.x && j + 1 < w.y && k + 1 < w.z;
-    if (interior) {
-      // The 3 x 3 x 3 neighbourhood straight from the volume, x lags as 4 float lanes.
-      const float* centre = vb.data + vb.linear(start.x + i, start.y + j, start.z + k);
-      const float lanes[4] = {px[0], px[1], px[2], 0.0f};
-      for (int dz = 0; dz < 3; ++dz)
-        for (int dy = 0; dy < 3; ++dy) {
-          const float f = wa * pz[dz] * py[dy];
-          const float* row = centre + (dz - 1) * sz + (dy - 1) * sy - 1;
-          float* pr = p4[dy + 3 * dz];
-          float* qr = qa4[dy + 3 * dz];
-#pragma omp simd
-          for (int l = 0; l < 4; ++l) {
-            const float g = f * lanes[l];
-            pr[l] += g * row[l];
-            qr[l] += g;
+  const int bx0 = std::max(0, start.x) / oa.block.x, bx1 = std::min(oa.blocks.x - 1, (start.x + w.x - 1) / oa.block.x);
+  const int by0 = std::max(0, start.y) / oa.block.y, by1 = std::min(oa.blocks.y - 1, (start.y + w.y - 1) / oa.block.y);
+  const int bz0 = std::max(0, start.z) / oa.block.z, bz1 = std::min(oa.blocks.z - 1, (start.z + w.z - 1) / oa.block.z);
+  auto holds_shell = [](int b, int size, int first, int last) {  // block b holds plane first or last
+    const int lo = b * size, hi = lo + size;
+    return (first >= lo && first < hi) || (last >= lo && last < hi);
+  };
+  alignas(16) float p4[9][4] = {};  // per (dy, dz) row, x lags as 4 float lanes (the 4th unused)
+  for (int bz = bz0; bz <= bz1; ++bz) {
+    const bool shell_z = holds_shell(bz, oa.block.z, start.z, start.z + w.z - 1);
+    for (int by = by0; by <= by1; ++by) {
+      const bool shell_y = holds_shell(by, oa.block.y, start.y, start.y + w.y - 1);
+      for (int bx = bx0; bx <= bx1; ++bx) {
+        if (!shell_z && !shell_y && !holds_shell(bx, oa.block.x, start.x, start.x + w.x - 1)) continue;
+        const std::size_t b = bx + static_cast<std::size_t>(oa.blocks.x) * (by + static_cast<std::size_t>(oa.blocks.y) * bz);
+        for (std::size_t e = oa.offsets[b]; e < oa.offsets[b + 1]; ++e) {
+          const OccupiedVoxels::Entry& v = oa.entries[e];
+          const int i = v.x - start.x, j = v.y - start.y, k = v.z - start.z;
+          // (Unsigned: one test each for below 0 and beyond the window.)
+          if (static_cast<unsigned>(i) >= static_cast<unsigned>(w.x) ||
+              static_cast<unsigned>(j) >= static_cast<unsigned>(w.y) ||
+              static_cast<unsigned>(k) >= static_cast<unsigned>(w.z))
+            continue;
+          if (static_cast<unsigned>(i - 1) < static_cast<unsigned>(w.x - 2) &&
+              static_cast<unsigned>(j - 1) < static_cast<unsigned>(w.y - 2) &&
+              static_cast<unsigned>(k - 1) < static_cast<unsigned>(w.z - 2))
+            continue;  // interior: no lag wraps, all in the contraction
+          const float wa = v.value * wx_[i] * wy_[j] * wz_[k];
+          alignas(16) float px[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+          float py[3], pz[3];
+          int xs[3], ys[3], zs[3];
+          // Per axis, which lags wrap: only (voxel, lag) pairs with a wrap are left here.
+          const bool wrap_x[3] = {i == 0, false, i == w.x - 1}, wrap_y[3] = {j == 0, false, j == w.y - 1},
+                     wrap_z[3] = {k == 0, false, k == w.z - 1};
+          for (int d = -1; d <= 1; ++d) {
+            px[d + 1] = px_[i + d + 2];
+            py[d + 1] = py_[j + d + 2];
+            pz[d + 1] = pz_[k + d + 2];
+            xs[d + 1] = start.x + wrap(i + d, w.x);
+            ys[d + 1] = start.y + wrap(j + d, w.y);
+            zs[d + 1] = start.z + wrap(k + d, w.z);
           }
-        }
-      continue;
-    }
-    // Edge of the window: the lags wrap around it (as the FFT's). Each axis's three wrapped
-    // coordinates are looked up once; a coordinate outside the volume reads 0.
-    std::ptrdiff_t ox[3], oy[3], oz[3];
-    bool in_x[3], in_y[3], in_z[3];
-    for (int d = -1; d <= 1; ++d) {
-      const int x = start.x + wrap(i + d, w.x), y = start.y + wrap(j + d, w.y), z = start.z + wrap(k + d, w.z);
-      in_x[d + 1] = x >= 0 && x < vb.nx;
-      in_y[d + 1] = y >= 0 && y < vb.ny;
-      in_z[d + 1] = z >= 0 && z < vb.nz;
-      ox[d + 1] = x;
-      oy[d + 1] = static_cast<std::ptrdiff_t>(y) * static_cast<std::ptrdiff_t>(sy);
-      oz[d + 1] = static_cast<std::ptrdiff_t>(z) * static_cast<std::ptrdiff_t>(sz);
-    }
-    for (int dz = 0; dz < 3; ++dz)
-      for (int dy = 0; dy < 3; ++dy) {
-        const float fzy = wa * pz[dz] * py[dy];
-        const bool row_in = in_z[dz] && in_y[dy];
-        const float* row = vb.data + (row_in ? oz[dz] + oy[dy] : 0);
-        double* pl = p + 3 * (dy + 3 * dz);
-        double* ql = qa + 3 * (dy + 3 * dz);
-        for (int dx = 0; dx < 3; ++dx) {
-          const float f = fzy * px[dx];
-          pl[dx] += f * (row_in && in_x[dx] ? row[ox[dx]] : 0.0f);
-          ql[dx] += f;
+          for (int dz = 0; dz < 3; ++dz)
+            for (int dy = 0; dy < 3; ++dy) {
+              const bool row_wraps = wrap_z[dz] || wrap_y[dy];
+              if (!row_wraps && !wrap_x[0] && !wrap_x[2]) continue;
+              const float f = wa * pz[dz] * py[dy];
+              // (Inside: every wrapped lag is inside the volume, no bounds tests.)
+              const bool row_in = inside || (zs[dz] >= 0 && zs[dz] < vb.nz && ys[dy] >= 0 && ys[dy] < vb.ny);
+              const float* row = vb.data + (row_in ? static_cast<std::size_t>(zs[dz]) * sz + static_cast<std::size_t>(ys[dy]) * sy : 0);
+              float* pr = p4[dy + 3 * dz];
+              for (int dx = 0; dx < 3; ++dx)
+                if (row_wraps || wrap_x[dx])
+                  pr[dx] += f * px[dx] * (row_in && (inside || (xs[dx] >= 0 && xs[dx] < vb.nx)) ? row[xs[dx]] : 0.0f);
+            }
         }
       }
+    }
   }
   for (int r = 0; r < 9; ++r)
-    for (int l = 0; l < 3; ++l) {
-      p[3 * r + l] += p4[r][l];
-      qa[3 * r + l] += qa4[r][l];
-    }
-  // R(s) = sum w(x) w(x+s) (A(x) - mean_a) (B(x+s) - mean_b), expanded.
-  auto combine = [&](double p_s, double qa_s, double qb_s, int dx, int dy, int dz) {
-    const double k = kx_[dx + 2] * ky_[dy + 2] * kz_[dz + 2];
-    return p_s - mean_b * qa_s - mean_a * qb_s + mean_a * mean_b * k;
-  };
+    for (int l = 0; l < 3; ++l) p[3 * r + l] += p4[r][l];
+
+  // R(s) of Eq. 2.16 at the 27 lags.
   double r[27];
   for (int dz = -1; dz <= 1; ++dz)
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
         const int l = lag_index(dx, dy, dz);
-        r[l] = combine(p[l], qa[l], qb[l], dx, dy, dz);
+        const double k = kx_[dx + 2] * ky_[dy + 2] * kz_[dz + 2];
+        r[l] = p[l] - mean_b * sums[kSlotQA + l] - mean_a * sums[kSlotQB + l] + mean_a * mean_b * k;
       }
-  // One lag outside the 27 (a peak's outer neighbour at +-2 along one axis), computed alone.
-  auto single_lag = [&](int dx, int dy, int dz) {
-    double ps = 0, qas = 0, qbs = 0;
-    for (std::size_t e = 0; e < count; ++e) {
-      const int i = wrap(s.a_i[e] + dx, w.x), j = wrap(s.a_j[e] + dy, w.y), k = wrap(s.a_k[e] + dz, w.z);
-      const float f = s.a_weight[e] * wx_[i] * wy_[j] * wz_[k];
-      ps += f * b_at(i, j, k);
-      qas += f;
-    }
-    for_window_entries(ob, [&](int i, int j, int k, float value) {
-      qbs += static_cast<double>(wx_[i] * wy_[j] * wz_[k] * value) * wx_[wrap(i - dx, w.x)] * wy_[wrap(j - dy, w.y)] *
-             wz_[wrap(k - dz, w.z)];
-    });
-    return combine(ps, qas, qbs, dx, dy, dz);
-  };
   const auto t2 = Clock::now();
   s.seconds.correlation += seconds_between(t1, t2);
 
   int best = 0;
   for (int l = 1; l < 27; ++l)
     if (r[l] > r[best]) best = l;
-  const int mx = best % 3 - 1, my = (best / 3) % 3 - 1, mz = best / 9 - 1;
+  const int m[3] = {best % 3 - 1, (best / 3) % 3 - 1, best / 9 - 1};
   const double centre = r[best];
-  auto value_at = [&](int dx, int dy, int dz) {
-    if (std::abs(dx) <= 1 && std::abs(dy) <= 1 && std::abs(dz) <= 1) return r[lag_index(dx, dy, dz)];
-    return single_lag(dx, dy, dz);
-  };
   double left[3], right[3];
-  const int m[3] = {mx, my, mz};
+  // The outer neighbours beyond the 27 lags (one per axis whose peak lag is +-1), all in one
+  // pass over the window's entries.
+  int outer[3][3];
+  int outer_axis[3];
+  int outer_count = 0;
   for (int axis = 0; axis < 3; ++axis) {
-    int lo[3] = {mx, my, mz}, hi[3] = {mx, my, mz};
+    int lo[3] = {m[0], m[1], m[2]}, hi[3] = {m[0], m[1], m[2]};
     lo[axis] -= 1;
     hi[axis] += 1;
-    left[axis] = value_at(lo[0], lo[1], lo[2]);
-    right[axis] = value_at(hi[0], hi[1], hi[2]);
-    // The peak continues beyond the lags searched: let the FFT find it.
-    if (left[axis] > centre || right[axis] > centre) {
+    if (lo[axis] >= -1) left[axis] = r[lag_index(lo[0], lo[1], lo[2])];
+    if (hi[axis] <= 1) right[axis] = r[lag_index(hi[0], hi[1], hi[2])];
+    if (lo[axis] < -1 || hi[axis] > 1) {
+      const int* lag = lo[axis] < -1 ? lo : hi;
+      outer[outer_count][0] = lag[0];
+      outer[outer_count][1] = lag[1];
+      outer[outer_count][2] = lag[2];
+      outer_axis[outer_count++] = axis;
+    }
+  }
+  if (outer_count > 0) {
+    double values[3];
+    outer_lags(oa, vb, ob, start, outer, outer_count, mean_a, mean_b, values);
+    for (int o = 0; o < outer_count; ++o) {
+      const int axis = outer_axis[o];
+      (outer[o][axis] < m[axis] ? left : right)[axis] = values[o];
+    }
+  }
+  for (int axis = 0; axis < 3; ++axis)
+    if (left[axis] > centre || right[axis] > centre) {  // the peak continues beyond: FFT
       fallback = true;
       s.seconds.peak += seconds_between(t2, Clock::now());
       return result;
     }
-  }
   float offsets[3];
   for (int axis = 0; axis < 3; ++axis) {
     const PeakFit1d fit = fit_peak_1d(left[axis], centre, right[axis], true, true);
@@ -331,6 +265,56 @@ WindowPeak DirectCorrelator::correlate(const OccupiedVoxels& oa, const VolumeVie
   result.valid = true;
   s.seconds.peak += seconds_between(t2, Clock::now());
   return result;
+}
+
+void DirectCorrelator::outer_lags(const OccupiedVoxels& oa, const VolumeView& vb, const OccupiedVoxels& ob, Int3 start,
+                                  const int lags[][3], int count, double mean_a, double mean_b, double* out) const {
+  const Int3 w = window_;
+  double ps[3] = {}, qas[3] = {}, qbs[3] = {};
+  auto for_entries = [&](const OccupiedVoxels& o, auto&& f) {
+    const int bx0 = std::max(0, start.x) / o.block.x, bx1 = std::min(o.blocks.x - 1, (start.x + w.x - 1) / o.block.x);
+    const int by0 = std::max(0, start.y) / o.block.y, by1 = std::min(o.blocks.y - 1, (start.y + w.y - 1) / o.block.y);
+    const int bz0 = std::max(0, start.z) / o.block.z, bz1 = std::min(o.blocks.z - 1, (start.z + w.z - 1) / o.block.z);
+    for (int bz = bz0; bz <= bz1; ++bz)
+      for (int by = by0; by <= by1; ++by)
+        for (int bx = bx0; bx <= bx1; ++bx) {
+          const std::size_t b = bx + static_cast<std::size_t>(o.blocks.x) * (by + static_cast<std::size_t>(o.blocks.y) * bz);
+          for (std::size_t e = o.offsets[b]; e < o.offsets[b + 1]; ++e) {
+            const OccupiedVoxels::Entry& v = o.entries[e];
+            const int i = v.x - start.x, j = v.y - start.y, k = v.z - start.z;
+            if (static_cast<unsigned>(i) >= static_cast<unsigned>(w.x) ||
+                static_cast<unsigned>(j) >= static_cast<unsigned>(w.y) ||
+                static_cast<unsigned>(k) >= static_cast<unsigned>(w.z))
+              continue;
+            f(i, j, k, v.value);
+          }
+        }
+  };
+  auto b_at = [&](int i, int j, int k) -> float {
+    const int x = start.x + i, y = start.y + j, z = start.z + k;
+    if (x < 0 || y < 0 || z < 0 || x >= vb.nx || y >= vb.ny || z >= vb.nz) return 0.0f;
+    return vb.data[vb.linear(x, y, z)];
+  };
+  // As correlate()'s single lag: P and QA over a's entries, QB over b's, circular in the window.
+  for_entries(oa, [&](int i, int j, int k, float value) {
+    const float wa = value * wx_[i] * wy_[j] * wz_[k];
+    for (int o = 0; o < count; ++o) {
+      const int ii = wrap(i + lags[o][0], w.x), jj = wrap(j + lags[o][1], w.y), kk = wrap(k + lags[o][2], w.z);
+      const float f = wa * wx_[ii] * wy_[jj] * wz_[kk];
+      ps[o] += f * b_at(ii, jj, kk);
+      qas[o] += f;
+    }
+  });
+  for_entries(ob, [&](int i, int j, int k, float value) {
+    const float wb = wx_[i] * wy_[j] * wz_[k] * value;
+    for (int o = 0; o < count; ++o)
+      qbs[o] += static_cast<double>(wb) * wx_[wrap(i - lags[o][0], w.x)] * wy_[wrap(j - lags[o][1], w.y)] *
+                wz_[wrap(k - lags[o][2], w.z)];
+  });
+  for (int o = 0; o < count; ++o) {
+    const double k = kx_[lags[o][0] + 2] * ky_[lags[o][1] + 2] * kz_[lags[o][2] + 2];
+    out[o] = ps[o] - mean_b * qas[o] - mean_a * qbs[o] + mean_a * mean_b * k;
+  }
 }
 
 }  // namespace tomorig::piv::detail

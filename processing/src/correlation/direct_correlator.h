@@ -3,10 +3,12 @@
 // after deformation the residual displacement is sub-voxel, so only the correlation values at
 // lags -1..1 (and the peak's outer neighbours) are needed, and a particle volume is mostly
 // empty. The occupied voxels of a volume (above a small fraction of its maximum) are listed
-// once per pass in blocks of the window step, shared by the overlapping windows; each window
-// then gathers its entries and evaluates Eq. 2.16 with the same weights, means, energies and
-// circular indexing as the FFT path, so where both find the same peak they give the same
-// coefficients (up to rounding and the dropped near-zero voxels).
+// once per pass in blocks of the window step, shared by the overlapping windows. The sums of
+// Eq. 2.16 over every window come from one separable contraction (window_lag_sums.h); each
+// window then adds its shell's lag products (the lags that wrap around it) and evaluates
+// Eq. 2.16 with the same weights, means, energies and circular indexing as the FFT path, so
+// where both find the same peak they give the same coefficients (up to rounding and the
+// dropped near-zero voxels).
 #include <cstdint>
 #include <vector>
 
@@ -17,15 +19,23 @@
 namespace tomorig::piv::detail {
 
 // Voxels whose magnitude exceeds `relative_threshold` times the volume's largest magnitude,
-// bucketed in blocks of `block` voxels per axis (scan order inside a block).
+// bucketed in blocks of `block` voxels per axis (scan order inside a block), and by row.
 struct OccupiedVoxels {
   struct Entry {
     std::uint16_t x, y, z;
     float value;
   };
+  struct RowEntry {
+    int x;
+    float value;
+  };
   Int3 block, blocks;                 // block size, block counts per axis
   std::vector<std::size_t> offsets;   // blocks + 1 offsets into entries
   std::vector<Entry> entries;
+  // The same voxels by row (y, z), x ascending: row r = y + ny z holds
+  // row_entries[row_offsets[r] .. row_offsets[r + 1]).
+  std::vector<std::size_t> row_offsets;
+  std::vector<RowEntry> row_entries;
   double occupied_fraction = 0;       // entries / voxels
 };
 // Fills `out`, reusing its memory (one list per volume for a whole correlation).
@@ -39,16 +49,20 @@ class DirectCorrelator {
   DirectCorrelator(Int3 window, WindowWeighting weighting, double gaussian_sigma);
 
   struct Scratch {
-    std::vector<float> a_weight;     // w(x) A(x) of the window's entries of a
-    std::vector<std::uint16_t> a_i, a_j, a_k;  // their window coordinates
     StageSeconds seconds;
   };
 
-  // The window of `va` (entries `oa`) at `start` against the window of `vb` (dense, read at
-  // the lags; entries `ob` for its sums) at the same start. `fallback` is false when the peak
-  // lies within the lags searched; otherwise the caller correlates this window by FFT.
-  WindowPeak correlate(const OccupiedVoxels& oa, const VolumeView& vb, const OccupiedVoxels& ob, Int3 start,
-                       Scratch& scratch, bool& fallback) const;
+  // The same window from its contracted sums (window_lag_sums.h: `sums` its kLagSlots floats)
+  // plus the lag products of its shell's entries of `oa`, whose lags wrap around the window;
+  // the peak's outer neighbours beyond +-1, when needed, from the window's entries. `fallback`
+  // is false when the peak lies within the lags searched; otherwise the caller correlates
+  // this window by FFT.
+  WindowPeak correlate_from_sums(const float* sums, const OccupiedVoxels& oa, const VolumeView& vb,
+                                 const OccupiedVoxels& ob, Int3 start, Scratch& scratch, bool& fallback) const;
+
+  const std::vector<float>& weights_x() const { return wx_; }
+  const std::vector<float>& weights_y() const { return wy_; }
+  const std::vector<float>& weights_z() const { return wz_; }
 
  private:
   Int3 window_;
@@ -59,6 +73,11 @@ class DirectCorrelator {
   double weight_energy_ = 0;             // sum of w^2 over the window
   // Circular autocorrelation of the weights per axis, K(d) for d = -2..2 at index d + 2.
   double kx_[5], ky_[5], kz_[5];
+
+  // R(s) of Eq. 2.16 at `count` (<= 3) lags with one component +-2, circular in the window,
+  // over every entry of the window.
+  void outer_lags(const OccupiedVoxels& oa, const VolumeView& vb, const OccupiedVoxels& ob, Int3 start,
+                  const int lags[][3], int count, double mean_a, double mean_b, double* out) const;
 };
 
 }  // namespace tomorig::piv::detail
