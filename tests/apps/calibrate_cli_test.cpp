@@ -310,8 +310,9 @@ TEST_F(CalibrateCli, PointsOnThreeLinesRefuseRational2AndSoloff3AndTheOthersAreS
 
 // Issue 18 acceptance, the experiment it came from: a camera behind 10 mm of glass into water,
 // a 3-D target whose 45 points lie on three lines, 0.3 px noise. rational2 and soloff3 are
-// refused naming the undetermined terms; pinhole, DLT and the refractive model are accepted,
-// and the stored refractive model is close to the true view between the lines too.
+// refused naming the undetermined terms; pinhole, DLT and the refractive model (with the
+// window's measured pose kept: three depths do not fix it) are accepted, and the stored
+// refractive model is close to the true view between the lines too.
 TEST_F(CalibrateCli, PointsOnThreeLinesBehindAWindowAcceptTheRefractiveModel) {
   calibration::FlatWindow window;
   window.medium_face_mm = -20;
@@ -331,9 +332,18 @@ TEST_F(CalibrateCli, PointsOnThreeLinesBehindAWindowAcceptTheRefractiveModel) {
     }
   const std::string points = write_points(rows);
   const auto out = dir_ / "calib.toml";
+  // Three depths barely fix the window's pose: fitted freely, the LM walks a flat valley and
+  // the message says to give the pose and keep it (exit 1, nothing written).
+  const CliResult free_pose = run_tomorig("calibrate --points " + points +
+                                          " --models refractive --image-size 2048,2048 --window-thickness 10 "
+                                          "--indices 1.0,1.49,1.33 --window-face -21 -o " + shell_quoted(out.string()));
+  EXPECT_EQ(free_pose.exit_code, 1) << free_pose.err;
+  EXPECT_NE(free_pose.err.find("--fix-window"), std::string::npos) << free_pose.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  // The wall's measured pose, kept: accepted beside pinhole and DLT.
   const CliResult r = run_tomorig("calibrate --points " + points +
                                   " --models rational2,soloff3,pinhole,dlt,refractive --image-size 2048,2048 "
-                                  "--window-thickness 10 --indices 1.0,1.49,1.33 --window-face -21 --json -o " +
+                                  "--window-thickness 10 --indices 1.0,1.49,1.33 --window-face -20 --fix-window --json -o " +
                                   shell_quoted(out.string()));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("the points do not determine the rational2 model: the 45 points lie on 3 lines parallel to x: "
