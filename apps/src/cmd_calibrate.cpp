@@ -30,6 +30,7 @@
 #include "tomorig/processing/calibration/calibration_file.h"
 #include "tomorig/processing/calibration/calibrate_cameras.h"
 #include "tomorig/processing/calibration/fit_camera_model.h"
+#include "tomorig/processing/calibration/target_depths.h"
 #include "tomorig/processing/calibration/target_file.h"
 #include "tomorig/processing/calibration/residual_plot.h"
 #include "tomorig/storage/image_file.h"
@@ -71,6 +72,7 @@ struct CalibrateArgs {
   std::string lattice = "square";
   double level_offset_mm = 0;
   std::string target_file;                  // --target-file T.toml: the target spec from a file
+  std::string target_z;                     // --target-z Z.csv: each target point's z from a side file
   std::vector<std::string> target_options;  // the target options given on the command line
   int min_points_per_plane = 8;
   std::string models = "pinhole";
@@ -311,6 +313,9 @@ Inputs read_inputs(const CalibrateArgs& args) {
   if (!args.points.empty()) {
     if (!args.target_file.empty())
       throw bad_input("--target-file describes the target in target images; it does not go with --points");
+    if (!args.target_z.empty())
+      throw bad_input("--target-z gives the z of the points detected in target images; with --points the Z column "
+                      "of the point file is each point's z");
     in.table = read_correspondence_csv(args.points);
     in.sizes = image_sizes(args, in.table.cameras.size());
     check_inside_images(args.points, in.table, in.sizes);
@@ -323,6 +328,16 @@ Inputs read_inputs(const CalibrateArgs& args) {
     throw bad_input(fmt::format("--min-points-per-plane {} is invalid: it must be >= 1", args.min_points_per_plane));
   std::string y_axis;
   const calibration::TargetSpec spec = target_spec(args, y_axis);
+  // Read before the detection, so that a malformed file costs nothing.
+  std::optional<calibration::TargetDepths> depths;
+  if (!args.target_z.empty()) {
+    if (const auto* dots = std::get_if<calibration::DotGridSpec>(&spec); dots && (dots->level_offset_mm != 0 || dots->origin_mm.z != 0))
+      throw bad_input(fmt::format("--target-z {} gives each point's z relative to the plate; a level offset (--level-offset "
+                                  "or level_offset_mm) or an origin z (origin_mm) does not go with it: put those depths "
+                                  "into the file",
+                                  args.target_z));
+    depths = calibration::read_target_depths(args.target_z);
+  }
   const TargetImageSet set = !args.session.empty()  ? read_session_targets(args.session, parse_z_list(args.z_list))
                              : !args.images.empty() ? find_target_images(args.images)
                                                     : read_image_list(args.image_list);
@@ -331,6 +346,10 @@ Inputs read_inputs(const CalibrateArgs& args) {
   for (const std::string& origin : detected.origins) fmt::print(stderr, "{}\n", origin);
   if (std::holds_alternative<calibration::DotGridSpec>(spec) && y_axis == "auto")
     fmt::print(stderr, "world +y points {} the images (--y-axis auto: a right-handed x, y, z)\n", orient_y_axis(detected));
+  if (depths) {
+    calibration::apply_target_depths(detected.table.cameras, *depths);
+    fmt::print(stderr, "point z from --target-z {} ({} points listed)\n", args.target_z, depths->z_mm.size());
+  }
   for (std::size_t c = 0; c < set.camera_names.size(); ++c)
     fmt::print(stderr, "camera {} ({}): {} target points on {} images of {} x {} px\n", c, set.camera_names[c],
                detected.table.cameras[c].size(),
@@ -373,20 +392,34 @@ void run_check(const CalibrateArgs& args) {
   print_report(results, "", "");
 }
 
-// --png DIR: one picture per camera and plane, "cam<i>_z<z>mm_residuals.png".
-std::map<std::pair<int, double>, std::filesystem::path> residual_plot_files(
-    const std::string& dir, const std::vector<std::vector<calibration::PointCorrespondence>>& cameras) {
-  std::map<std::pair<int, double>, std::filesystem::path> files;
+// --png DIR: one picture per camera and plane, "cam<i>_z<z>mm_residuals.png". The names are
+// made once, before any fit, where each is checked (no picture is replaced without
+// --overwrite); the same list is written after the fit.
+struct ResidualPlotFiles {
+  std::filesystem::path dir;                                      // empty: no --png
+  std::map<std::pair<int, double>, std::filesystem::path> files;  // (camera, plane z) -> picture
+};
+
+ResidualPlotFiles prepare_residual_plots(const std::string& dir,
+                                         const std::vector<std::vector<calibration::PointCorrespondence>>& cameras,
+                                         bool overwrite) {
+  ResidualPlotFiles plots{dir, {}};
+  if (dir.empty()) return plots;
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
   for (std::size_t c = 0; c < cameras.size(); ++c)
     for (const auto& p : cameras[c])
-      files.try_emplace({static_cast<int>(c), p.world.z},
+      plots.files.try_emplace({static_cast<int>(c), p.world.z},
                         std::filesystem::path(dir) / fmt::format("cam{}_z{:g}mm_residuals.png", c, p.world.z));
-  return files;
+  for (const auto& [key, file] : plots.files) storage::check_output_path(file.string(), overwrite, "residual plot");
+  return plots;
 }
 
-void write_residual_plots(const std::string& dir, const std::vector<std::vector<calibration::PointCorrespondence>>& cameras,
+void write_residual_plots(const ResidualPlotFiles& plots,
+                          const std::vector<std::vector<calibration::PointCorrespondence>>& cameras,
                           const std::vector<calibration::CameraCalibration>& calibrations) {
-  for (const auto& [key, file] : residual_plot_files(dir, cameras)) {
+  if (plots.dir.empty()) return;
+  for (const auto& [key, file] : plots.files) {
     const auto& [camera, z] = key;
     const auto stored = std::find_if(calibrations.begin(), calibrations.end(),
                                      [camera = camera](const auto& c) { return c.id == camera; });
@@ -398,7 +431,7 @@ void write_residual_plots(const std::string& dir, const std::vector<std::vector<
         *stored->model, plane, stored->image_size, fmt::format("camera {}, plane z = {:g} mm, {}", camera, z, stored->report.model));
     storage::write_png(file, plot.image);
   }
-  fmt::print(stderr, "residual plots in {}\n", dir);
+  fmt::print(stderr, "residual plots in {}\n", plots.dir.string());
 }
 
 void run(const CalibrateArgs& args) {
@@ -436,18 +469,14 @@ void run(const CalibrateArgs& args) {
   options.notice = [](const std::string& text) { fmt::print(stderr, "{}\n", text); };
   const Inputs in = read_inputs(args);
   options.camera_names = in.camera_names;
-  if (!args.png.empty()) {  // before any fit: no picture is replaced without --overwrite
-    std::error_code ec;
-    std::filesystem::create_directories(args.png, ec);
-    for (const auto& [key, file] : residual_plot_files(args.png, in.table.cameras))
-      storage::check_output_path(file.string(), args.overwrite, "residual plot");
-  }
+  // Before any fit: no picture is replaced without --overwrite.
+  const ResidualPlotFiles residual_plots = prepare_residual_plots(args.png, in.table.cameras, args.overwrite);
 
   const calibration::CalibrateCamerasReport result = calibration::calibrate_cameras(in.table.cameras, in.sizes, options);
   // Nothing is written unless the stored model fitted every camera.
   if (!result.stored_failure) calibration::save_calibration(args.out, result.calibrations);
   for (const std::string& warning : result.poor_fit_warnings()) fmt::print(stderr, "warning: {}\n", warning);
-  if (!args.png.empty() && !result.stored_failure) write_residual_plots(args.png, in.table.cameras, result.calibrations);
+  if (!result.stored_failure) write_residual_plots(residual_plots, in.table.cameras, result.calibrations);
   const std::string written = result.stored_failure ? std::string() : args.out;
   if (args.json.wanted()) {
     nlohmann::json j = json_summary("calibrate");
@@ -501,6 +530,9 @@ void add_calibrate_command(CLI::App& root) {
   cmd->add_option("--target-file", args->target_file,
                   "Target description TOML (kind, pitch_mm, lattice, level_offset_mm, dots, y_axis, origin_mm, corners; "
                   "docs/calibration.md) instead of the target options");
+  cmd->add_option("--target-z", args->target_z,
+                  "Target images: each target point's z from a side file, a CSV with the header X,Y,Z (world x, y as "
+                  "--points-out writes them; z relative to the plate, mm), for plates whose points lie at several depths");
   cmd->add_option("--max-feature-px", args->max_feature_px,
                   "Dot grid: dots and marker are smaller than this many pixels (0 = 1/8 of the image)")
       ->capture_default_str();

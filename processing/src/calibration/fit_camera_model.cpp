@@ -94,10 +94,15 @@ std::unique_ptr<CameraModel> fit_camera_model(std::string_view model_name, std::
   if (!report.converged && options.require_convergence)
     throw runtime_error(fmt::format("{}: the {} fit did not converge in {} iterations{}; check the correspondences for "
                                     "outliers, or allow more iterations (--max-iterations on the command line, "
-                                    "FitOptions::max_iterations in code)",
+                                    "FitOptions::max_iterations in code){}",
                                     options.camera, model_name, options.max_iterations,
                                     options.retry_factor > 1 ? fmt::format(", nor in {} on a second attempt", attempt.max_iterations)
-                                                             : std::string()));
+                                                             : std::string(),
+                                    model_name == "refractive" && options.fit_window_pose
+                                        ? "; points at few depths (planes or lines) barely determine the window's pose: "
+                                          "measure it, give it (--window-face, --window-normal) and keep it (--fix-window, "
+                                          "FitOptions::fit_window_pose = false)"
+                                        : ""));
   measure_residuals(*model, points, report);
   return model;
 }

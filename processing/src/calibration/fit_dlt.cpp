@@ -7,6 +7,7 @@
 
 #include "mapping_fit.h"
 #include "model_fits.h"
+#include "projection_fit.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/calibration/dlt_camera.h"
 #include "tomorig/processing/calibration/pinhole_camera.h"
@@ -151,28 +152,21 @@ std::unique_ptr<CameraModel> fit_pinhole(std::span<const PointCorrespondence> po
                                 "orientation of the image or of the world axes",
                                 options.camera));
   const PinholeParameters& start = decomposition->parameters;
-  // Parameters: fx, fy, cx, cy, rotation vector (3), t (3); residuals in normalised pixels.
+  // Parameters: fx, fy, cx, cy, rotation vector (3), t (3).
   const std::array<double, 10> v = pinhole_vector(start);
   Eigen::VectorXd p = Eigen::Map<const Eigen::VectorXd>(v.data(), kPinholeUnknowns);
 
-  const int count = static_cast<int>(points.size());
-  const ResidualFunction project_all = [&](const Eigen::VectorXd& q, Eigen::VectorXd& r, Eigen::MatrixXd*) {
+  const ProjectPoints project = [&](const Eigen::VectorXd& q, std::span<Vec2d> pixels) {
     const PinholeParameters pp = pinhole_of(q);
-    r.resize(2 * count);
-    for (int i = 0; i < count; ++i) {
+    for (std::size_t i = 0; i < points.size(); ++i) {
       const Vec3d& X = points[i].world;
       const double xc = pp.R[0] * X.x + pp.R[1] * X.y + pp.R[2] * X.z + pp.t.x;
       const double yc = pp.R[3] * X.x + pp.R[4] * X.y + pp.R[5] * X.z + pp.t.y;
       const double zc = pp.R[6] * X.x + pp.R[7] * X.y + pp.R[8] * X.z + pp.t.z;
-      r(2 * i) = (pp.fx * xc / zc + pp.cx - points[i].pixel.x) / n.image_scale;
-      r(2 * i + 1) = (pp.fy * yc / zc + pp.cy - points[i].pixel.y) / n.image_scale;
+      pixels[i] = {pp.fx * xc / zc + pp.cx, pp.fy * yc / zc + pp.cy};
     }
   };
-  const ResidualFunction with_jacobian = [&](const Eigen::VectorXd& q, Eigen::VectorXd& r, Eigen::MatrixXd* J) {
-    project_all(q, r, nullptr);
-    if (J) numeric_jacobian(project_all, q, 2 * count, *J);
-  };
-  const LmResult lm = levenberg_marquardt(with_jacobian, 2 * count, p, lm_settings(options));
+  const LmResult lm = fit_projection(points, n.image_scale, project, p, lm_settings(options));
   check_fit(lm, kPinholeUnknowns, "pinhole", "projection", options);
   report.normalization = n;
   report.iterations = lm.iterations;

@@ -8,6 +8,7 @@
 #include <fmt/core.h>
 
 #include "model_fits.h"
+#include "projection_fit.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/calibration/lens_camera.h"
 
@@ -32,26 +33,19 @@ std::unique_ptr<CameraModel> fit_lens(std::span<const PointCorrespondence> point
   Eigen::VectorXd p = Eigen::VectorXd::Zero(kLensParameters);
   for (int i = 0; i < kPinholeParameters; ++i) p(i) = start.parameters[static_cast<std::size_t>(i)];
 
-  const int count = static_cast<int>(points.size());
-  const ResidualFunction project_all = [&](const Eigen::VectorXd& q, Eigen::VectorXd& r, Eigen::MatrixXd*) {
+  const ProjectPoints project = [&](const Eigen::VectorXd& q, std::span<Vec2d> pixels) {
     const PinholeParameters pp = pinhole_of(q);
     const LensDistortion d = distortion_of(q);
-    r.resize(2 * count);
-    for (int i = 0; i < count; ++i) {
+    for (std::size_t i = 0; i < points.size(); ++i) {
       const Vec3d& X = points[i].world;
       const double xc = pp.R[0] * X.x + pp.R[1] * X.y + pp.R[2] * X.z + pp.t.x;
       const double yc = pp.R[3] * X.x + pp.R[4] * X.y + pp.R[5] * X.z + pp.t.y;
       const double zc = pp.R[6] * X.x + pp.R[7] * X.y + pp.R[8] * X.z + pp.t.z;
       const Vec2d u = d.distort({xc / zc, yc / zc});
-      r(2 * i) = (pp.fx * u.x + pp.cx - points[i].pixel.x) / n.image_scale;
-      r(2 * i + 1) = (pp.fy * u.y + pp.cy - points[i].pixel.y) / n.image_scale;
+      pixels[i] = {pp.fx * u.x + pp.cx, pp.fy * u.y + pp.cy};
     }
   };
-  const ResidualFunction with_jacobian = [&](const Eigen::VectorXd& q, Eigen::VectorXd& r, Eigen::MatrixXd* J) {
-    project_all(q, r, nullptr);
-    if (J) numeric_jacobian(project_all, q, 2 * count, *J);
-  };
-  const LmResult lm = levenberg_marquardt(with_jacobian, 2 * count, p, lm_settings(options));
+  const LmResult lm = fit_projection(points, n.image_scale, project, p, lm_settings(options));
   check_fit(lm, kLensParameters, "pinhole_distortion", "projection", options);
   report.normalization = n;
   report.iterations = lm.iterations;

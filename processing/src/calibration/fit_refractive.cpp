@@ -14,6 +14,7 @@
 #include <fmt/core.h>
 
 #include "model_fits.h"
+#include "projection_fit.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/calibration/refractive_camera.h"
 
@@ -62,33 +63,20 @@ RefractiveCamera camera_of(const Eigen::VectorXd& q, const Frame& f) {
 // LM over the parameters marked free in `free`; the others keep their values in `full`.
 LmResult fit_subset(std::span<const PointCorrespondence> points, const Normalization& n, const Frame& frame,
                     const std::vector<int>& free, Eigen::VectorXd& full, const LmSettings& settings) {
-  const int count = static_cast<int>(points.size());
   auto expand = [&](const Eigen::VectorXd& p) {
     Eigen::VectorXd q = full;
     for (std::size_t k = 0; k < free.size(); ++k) q(free[k]) = p(static_cast<int>(k));
     return q;
   };
-  const ResidualFunction project_all = [&](const Eigen::VectorXd& p, Eigen::VectorXd& r, Eigen::MatrixXd*) {
-    r.resize(2 * count);
-    try {
-      const RefractiveCamera camera = camera_of(expand(p), frame);
-      for (int i = 0; i < count; ++i) {
-        const Vec2d u = camera.project(points[i].world);
-        r(2 * i) = (u.x - points[i].pixel.x) / n.image_scale;
-        r(2 * i + 1) = (u.y - points[i].pixel.y) / n.image_scale;
-      }
-    } catch (const Error&) {
-      // A step that puts the camera beyond the window (or an index below 1): not a candidate.
-      r.setConstant(std::numeric_limits<double>::quiet_NaN());
-    }
-  };
-  const ResidualFunction with_jacobian = [&](const Eigen::VectorXd& p, Eigen::VectorXd& r, Eigen::MatrixXd* J) {
-    project_all(p, r, nullptr);
-    if (J) numeric_jacobian(project_all, p, 2 * count, *J);
+  // camera_of throws for a step that puts the camera beyond the window (or an index below 1):
+  // fit_projection takes that step as no candidate.
+  const ProjectPoints project = [&](const Eigen::VectorXd& p, std::span<Vec2d> pixels) {
+    const RefractiveCamera camera = camera_of(expand(p), frame);
+    for (std::size_t i = 0; i < points.size(); ++i) pixels[i] = camera.project(points[i].world);
   };
   Eigen::VectorXd p(static_cast<int>(free.size()));
   for (std::size_t k = 0; k < free.size(); ++k) p(static_cast<int>(k)) = full(free[k]);
-  const LmResult lm = levenberg_marquardt(with_jacobian, 2 * count, p, settings);
+  const LmResult lm = fit_projection(points, n.image_scale, project, p, settings);
   full = expand(p);
   return lm;
 }
@@ -99,7 +87,8 @@ std::unique_ptr<CameraModel> fit_refractive(std::span<const PointCorrespondence>
                                             FitReport& report) {
   if (!options.window)
     throw bad_input(fmt::format("{}: the refractive model needs the window: its thickness, indices and approximate pose "
-                                "(--window on the command line, FitOptions::window in code)",
+                                "(--window-thickness, --indices, --window-face and --window-normal on the command line, FitOptions::window in "
+                                "code)",
                                 options.camera));
   if (const std::string problem = options.window->validate(); !problem.empty())
     throw bad_input(fmt::format("{}: window: {}", options.camera, problem));

@@ -1,5 +1,6 @@
 // Traverse-error correction (thesis Sect. 6.3.3): alternate per-plane offset estimates by
-// disparity minimisation with pinhole re-fits, then fit the final model.
+// disparity minimisation with re-fits of the alternation model (the pinhole, or the refractive
+// model behind a window), then fit the final model.
 #include "tomorig/processing/calibration/traverse_correction.h"
 
 #include <algorithm>
@@ -91,35 +92,39 @@ std::string camera_name(const TraverseCorrectionOptions& o, std::size_t c) {
 
 }  // namespace
 
-void remove_gauge(std::span<Vec3d> offsets_mm, std::span<const double> plane_z_mm) {
+std::string alternation_model_for(const std::string& final_model) {
+  return final_model == "refractive" ? "refractive" : "pinhole";
+}
+
+void remove_gauge(std::span<Vec3d> offsets_mm, std::span<const double> plane_z_mm, bool remove_y_trend) {
   const std::size_t n = offsets_mm.size();
   if (n == 0 || plane_z_mm.size() != n) return;
   double zm = 0;
   Vec3d mean{0, 0, 0};
   for (std::size_t k = 0; k < n; ++k) zm += plane_z_mm[k] / n, mean = mean + offsets_mm[k] * (1.0 / n);
-  double szz = 0, sxz = 0, szz_off = 0;
+  double szz = 0;
+  Vec3d s_offset_z{0, 0, 0};
   for (std::size_t k = 0; k < n; ++k) {
     const double dz = plane_z_mm[k] - zm;
     szz += dz * dz;
-    sxz += dz * (offsets_mm[k].x - mean.x);
-    szz_off += dz * (offsets_mm[k].z - mean.z);
+    s_offset_z = s_offset_z + (offsets_mm[k] - mean) * dz;
   }
-  const double slope_x = szz > 0 ? sxz / szz : 0, slope_z = szz > 0 ? szz_off / szz : 0;
-  for (std::size_t k = 0; k < n; ++k) {
-    const double dz = plane_z_mm[k] - zm;
-    offsets_mm[k] = offsets_mm[k] - mean;
-    offsets_mm[k].x -= slope_x * dz;
-    offsets_mm[k].z -= slope_z * dz;
-  }
+  Vec3d slope = szz > 0 ? s_offset_z * (1.0 / szz) : Vec3d{0, 0, 0};
+  if (!remove_y_trend) slope.y = 0;
+  for (std::size_t k = 0; k < n; ++k) offsets_mm[k] = offsets_mm[k] - mean - slope * (plane_z_mm[k] - zm);
 }
 
 std::string TraverseCorrectionOptions::validate() const {
   if (max_cycles < 1) return fmt::format("traverse correction: max_cycles = {} must be >= 1", max_cycles);
   if (!(tolerance_um > 0) || !std::isfinite(tolerance_um))
     return fmt::format("traverse correction: tolerance_um = {} must be > 0", tolerance_um);
-  const auto& names = camera_model_names();
+  const auto& names = all_camera_model_names();
   if (std::find(names.begin(), names.end(), final_model) == names.end())
-    return fmt::format("traverse correction: final_model '{}' is unknown", final_model);
+    return fmt::format("traverse correction: final_model '{}' is unknown; known models: {}", final_model,
+                       fmt::join(names, ", "));
+  if (final_model == "refractive" && !fit.window)
+    return "traverse correction: the refractive final model needs the window (FitOptions::window; --window-thickness "
+           "and its companions on the command line)";
   return fit.validate();
 }
 
@@ -162,8 +167,9 @@ TraverseCorrectionResult correct_traverse(std::span<const std::vector<PointCorre
     if (points_per_camera[c].empty())
       throw bad_input(fmt::format("traverse correction: {} has no points", camera_name(options, c)));
 
+  result.alternation_model = alternation_model_for(options.final_model);
   std::vector<Vec3d> offsets(planes, Vec3d{0, 0, 0});
-  auto fit_pinholes = [&](std::vector<std::unique_ptr<CameraModel>>& models, std::vector<FitReport>& reports) {
+  auto refit = [&](std::vector<std::unique_ptr<CameraModel>>& models, std::vector<FitReport>& reports) {
     models.clear();
     reports.assign(cameras, {});
     result.corrected_points.clear();
@@ -171,7 +177,8 @@ TraverseCorrectionResult correct_traverse(std::span<const std::vector<PointCorre
       result.corrected_points.push_back(apply_plane_offsets(points_per_camera[c], result.plane_z_mm, offsets));
       FitOptions fo = options.fit;
       fo.camera = camera_name(options, c);
-      models.push_back(fit_camera_model("pinhole", result.corrected_points.back(), image_sizes[c], fo, reports[c]));
+      models.push_back(
+          fit_camera_model(result.alternation_model, result.corrected_points.back(), image_sizes[c], fo, reports[c]));
     }
   };
   // The shift of plane k that best explains the disparities of the given cameras.
@@ -189,11 +196,12 @@ TraverseCorrectionResult correct_traverse(std::span<const std::vector<PointCorre
     }
     return shifts;
   };
-  auto remove_mean = [&](std::vector<Vec3d>& v) { remove_gauge(v, result.plane_z_mm); };
+  const bool y_trend_is_gauge = result.alternation_model == "refractive";
+  auto remove_mean = [&](std::vector<Vec3d>& v) { remove_gauge(v, result.plane_z_mm, y_trend_is_gauge); };
 
   for (result.cycles = 1; result.cycles <= options.max_cycles; ++result.cycles) {
-    fit_pinholes(result.pinholes, result.pinhole_reports);
-    std::vector<Vec3d> shifts = plane_shifts(result.pinholes, cameras);
+    refit(result.alternation_models, result.alternation_reports);
+    std::vector<Vec3d> shifts = plane_shifts(result.alternation_models, cameras);
     remove_mean(shifts);
     double largest = 0;
     for (std::size_t k = 0; k < planes; ++k) {
@@ -206,11 +214,11 @@ TraverseCorrectionResult correct_traverse(std::span<const std::vector<PointCorre
     }
   }
   result.cycles = std::min(result.cycles, options.max_cycles);
-  fit_pinholes(result.pinholes, result.pinhole_reports);
+  refit(result.alternation_models, result.alternation_reports);
   result.offsets_mm = offsets;
 
   for (std::size_t c = 0; c < cameras; ++c) {
-    std::vector<Vec3d> own = plane_shifts(result.pinholes, c);
+    std::vector<Vec3d> own = plane_shifts(result.alternation_models, c);
     remove_mean(own);
     for (std::size_t k = 0; k < planes; ++k) own[k] = own[k] + offsets[k];
     result.per_camera_offsets_mm.push_back(std::move(own));
@@ -220,9 +228,9 @@ TraverseCorrectionResult correct_traverse(std::span<const std::vector<PointCorre
   for (std::size_t c = 0; c < cameras; ++c) {
     FitOptions fo = options.fit;
     fo.camera = camera_name(options, c);
-    if (options.final_model == "pinhole") {
-      result.models.push_back(result.pinholes[c]->clone());
-      result.reports[c] = result.pinhole_reports[c];
+    if (options.final_model == result.alternation_model) {
+      result.models.push_back(result.alternation_models[c]->clone());
+      result.reports[c] = result.alternation_reports[c];
     } else {
       result.models.push_back(
           fit_camera_model(options.final_model, result.corrected_points[c], image_sizes[c], fo, result.reports[c]));

@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
+#include <random>
 
 #include <gtest/gtest.h>
 
@@ -11,6 +13,7 @@
 #include "tomorig/processing/calibration/target_detection.h"
 #include "tomorig/processing/calibration/traverse_correction.h"
 #include "tomorig/simulators/calibration_target.h"
+#include "tomorig/simulators/window_view.h"
 
 namespace tomorig::calibration {
 namespace {
@@ -130,6 +133,136 @@ TEST(TraverseCorrection, RefusesOneCameraOrOnePlane) {
     EXPECT_EQ(e.kind(), ErrorKind::bad_input);
     EXPECT_NE(std::string(e.what()).find("spline"), std::string::npos);
   }
+}
+
+// Behind a window into water (issue 18): two cameras yawed +-25 degrees behind 10 mm of glass
+// (1.0 / 1.49 / 1.33, medium face at z = -20 mm, tilted 0.5 degrees), an 11 x 11 dot target on 7
+// planes whose traverse positions are off by up to 2 / 8 / 20 um (x / y / z), 0.02 px noise.
+// The true offsets are drawn in the refractive alternation's gauge (no mean, no linear trend
+// over z), so that the corrected world is the true one and the models can be compared with the
+// true views.
+struct WindowRig {
+  std::vector<sim::WindowView> views;
+  std::vector<double> plane_z{-6, -4, -2, 0, 2, 4, 6};
+  std::vector<Vec3d> truth;  // true plane offsets, already in the correction's gauge
+  std::vector<std::vector<PointCorrespondence>> points;  // world at the nominal z
+  std::vector<ImageSize> sizes;
+  FlatWindow start;  // the user's approximate window: untilted, 1 mm off
+};
+
+WindowRig window_rig() {
+  WindowRig rig;
+  FlatWindow w;
+  const double tilt = 0.5 * std::numbers::pi / 180;
+  w.normal = {std::sin(tilt), 0, std::cos(tilt)};
+  w.medium_face_mm = -20;
+  w.thickness_mm = 10;
+  w.n_air = 1.0, w.n_window = 1.49, w.n_medium = 1.33;
+  rig.start = w;
+  rig.start.normal = {0, 0, 1};
+  rig.start.medium_face_mm = -21;
+  constexpr int kSize = 2048;
+  for (double yaw : {25.0, -25.0}) {
+    rig.views.push_back({PinholeCamera::yawed(yaw, 100.0, 7.4, 300.0, kSize, kSize), w});
+    rig.sizes.push_back({kSize, kSize});
+  }
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (std::size_t k = 0; k < rig.plane_z.size(); ++k)
+    rig.truth.push_back({0.002 * u(rng), 0.008 * u(rng), 0.020 * u(rng)});
+  remove_gauge(rig.truth, rig.plane_z, /*remove_y_trend=*/true);
+  std::normal_distribution<double> noise(0.0, 0.02);
+  for (const sim::WindowView& view : rig.views) {
+    rig.points.emplace_back();
+    for (std::size_t k = 0; k < rig.plane_z.size(); ++k)
+      for (int i = 0; i < 11; ++i)
+        for (int j = 0; j < 11; ++j) {
+          const Vec3d nominal{-15.0 + 3.0 * i, -15.0 + 3.0 * j, rig.plane_z[k]};
+          const Vec2d pixel = view.project(nominal + rig.truth[k]);
+          rig.points.back().push_back({nominal, {pixel.x + noise(rng), pixel.y + noise(rng)}});
+        }
+  }
+  return rig;
+}
+
+// Largest distance (px) between a model and the true view at points of the box not on the grid.
+double held_out_max_px(const CameraModel& model, const sim::WindowView& view) {
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> xy(-14.5, 14.5), z(-6.0, 6.0);
+  double worst = 0;
+  for (int k = 0; k < 200; ++k) {
+    const Vec3d w{xy(rng), xy(rng), z(rng)};
+    const Vec2d a = model.project(w), b = view.project(w);
+    worst = std::max(worst, std::hypot(a.x - b.x, a.y - b.y));
+  }
+  return worst;
+}
+
+double largest_offset_error_um(const std::vector<Vec3d>& estimate, const std::vector<Vec3d>& truth) {
+  double worst = 0;
+  for (std::size_t k = 0; k < truth.size(); ++k) worst = std::max(worst, (estimate[k] - truth[k]).norm() * 1e3);
+  return worst;
+}
+
+TEST(TraverseCorrection, RefractiveModelBehindGlassIntoWaterRecoversPlaneOffsets) {
+  const WindowRig rig = window_rig();
+  TraverseCorrectionOptions o;
+  o.final_model = "refractive";
+  o.fit.window = rig.start;
+  o.tolerance_um = 0.01;  // 100x finer than asserted below; each cycle re-fits two refractive models
+  const auto t0 = std::chrono::steady_clock::now();
+  const TraverseCorrectionResult r = correct_traverse(rig.points, rig.sizes, o);
+  std::printf("refractive correction: %d cycles, converged %d, %.2f s\n", r.cycles, int(r.converged),
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  EXPECT_TRUE(r.converged);
+  EXPECT_EQ(r.alternation_model, "refractive");
+  ASSERT_EQ(r.offsets_mm.size(), rig.truth.size());
+  double largest_truth = 0;
+  for (std::size_t k = 0; k < rig.truth.size(); ++k) {
+    std::printf("plane %zu: truth (%.2f %.2f %.2f) um, estimate (%.2f %.2f %.2f) um\n", k, rig.truth[k].x * 1e3,
+                rig.truth[k].y * 1e3, rig.truth[k].z * 1e3, r.offsets_mm[k].x * 1e3, r.offsets_mm[k].y * 1e3,
+                r.offsets_mm[k].z * 1e3);
+    largest_truth = std::max(largest_truth, rig.truth[k].norm() * 1e3);
+  }
+  EXPECT_GT(largest_truth, 5.0);  // there are stage errors to find
+  const double refractive_error = largest_offset_error_um(r.offsets_mm, rig.truth);
+  EXPECT_LT(refractive_error, 1.0);
+  ASSERT_EQ(r.models.size(), 2u);
+  for (std::size_t cam = 0; cam < 2; ++cam) {
+    EXPECT_EQ(r.models[cam]->model_name(), "refractive");
+    // Without the correction the same model is fitted to the nominal plane positions.
+    FitOptions fo;
+    fo.window = rig.start;
+    FitReport plain;
+    const auto uncorrected = fit_camera_model("refractive", rig.points[cam], rig.sizes[cam], fo, plain);
+    std::printf("camera %zu: refractive fit: %d iterations with correction, %d without\n", cam + 1,
+                r.reports[cam].iterations, plain.iterations);
+    const double with = held_out_max_px(*r.models[cam], rig.views[cam]);
+    const double without = held_out_max_px(*uncorrected, rig.views[cam]);
+    std::printf("camera %zu: refractive fit RMS %.4f px without, %.4f px with correction; against truth at held-out "
+                "points max %.4f px without, %.4f px with\n",
+                cam + 1, plain.forward_rms_px, r.reports[cam].forward_rms_px, without, with);
+    EXPECT_LT(with, 0.05) << "camera " << cam + 1;
+    EXPECT_LT(r.reports[cam].forward_rms_px, 0.8 * plain.forward_rms_px) << "camera " << cam + 1;
+  }
+  // The thesis's pinhole alternation on the same points: the refraction it cannot describe
+  // leaks into the offsets.
+  TraverseCorrectionOptions pinhole_alternation;
+  pinhole_alternation.final_model = "pinhole";
+  const TraverseCorrectionResult p = correct_traverse(rig.points, rig.sizes, pinhole_alternation);
+  const double pinhole_error = largest_offset_error_um(p.offsets_mm, rig.truth);
+  std::printf("largest offset error: %.3f um (refractive alternation), %.3f um (pinhole alternation)\n",
+              refractive_error, pinhole_error);
+  EXPECT_GT(pinhole_error, 2 * refractive_error);
+}
+
+TEST(TraverseCorrection, RefractiveFinalModelWithoutAWindowIsRefused) {
+  TraverseCorrectionOptions o;
+  o.final_model = "refractive";
+  EXPECT_NE(o.validate().find("needs the window"), std::string::npos) << o.validate();
+  o.fit.window = FlatWindow{};
+  o.fit.window->thickness_mm = 10;
+  EXPECT_EQ(o.validate(), "");
 }
 
 }  // namespace
