@@ -58,7 +58,8 @@ sim::SprayOptions spray_options_from(const config::RigConfig& rig) {
   sim::SprayOptions o;
   o.reduced = reduced;
   o.seed = s.seed;
-  o.pattern = sim::parse_spray_pattern(s.spray);
+  o.pattern = s.spray == config::SprayPattern::hollow_cone ? sim::SprayPattern::hollow_cone
+                                                          : sim::SprayPattern::jet_in_crossflow;
   o.noise = s.noise;
   o.pulse_b_energy = s.pulse_b_energy;
   o.dt_us = rig.trigger.dt_us;
