@@ -69,7 +69,7 @@ void run(const RunArgs& args) {
   // With --json on stdout the header goes to stderr, so that stdout is the JSON object alone.
   fmt::print(args.json.to_stdout() ? stderr : stdout, "tomorig run: rig '{}', {} cameras, {}{}\n", rig.name, rig.cameras.size(),
              rig::run_length_text(options.acquisition),
-             rig.simulation ? (rig.simulation->case_name == "spray-thesis" ? fmt::format(", case spray-thesis ({})", rig.simulation->spray) : fmt::format(", case {} at {} ppp", rig.simulation->case_name, rig.simulation->ppp))
+             rig.simulation ? (rig.simulation->case_name == "spray-thesis" ? fmt::format(", case spray-thesis ({})", config::to_string(rig.simulation->spray)) : fmt::format(", case {} at {} ppp", rig.simulation->case_name, rig.simulation->ppp))
                             : std::string());
   std::fflush(stdout);
   if (!runner.status_endpoint().empty()) fmt::print(stderr, "run: status JSON on {}\n", runner.status_endpoint());

@@ -84,7 +84,7 @@ void run_spray_thesis(const SimulateFlags& f, storage::Compression compression) 
   sim::SprayOptions o;
   o.reduced = f.reduced;
   if (f.seed_opt->count()) o.seed = f.seed;
-  o.pattern = sim::parse_spray_pattern(f.spray);
+  o.pattern = rig::parse_spray_pattern(f.spray, "--spray");
   std::string written;
   if (f.targets) {
     if (f.sets_opt->count()) throw bad_input("--targets renders one set per PSF depth (13): --sets does not apply");

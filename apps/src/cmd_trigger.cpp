@@ -32,13 +32,13 @@ nlohmann::json plan_json(const std::string& rig_name, const trigger::TimingPlan&
     nlohmann::json pulses = nlohmann::json::array();
     for (const auto& p : ch.pulses) pulses.push_back(pulse_json(p));
     nlohmann::json c = {{"name", ch.spec.name},
-                        {"role", trigger::to_string(ch.spec.role)},
+                        {"role", config::to_string(ch.spec.role)},
                         {"delay_us", us(ch.spec.delay_ns)},
                         {"driven_by", trigger::device_drives(device, ch.spec) ? device.device : "pulse_generator"},
                         {"pulses", pulses}};
     if (!ch.spec.light_source.empty()) {
       c["light_source"] = ch.spec.light_source;
-      c["makes"] = trigger::to_string(ch.spec.pulses);
+      c["makes"] = config::to_string(ch.spec.pulses);
     }
     if (ch.spec.wired()) c["gpio"] = {{"chip", ch.spec.chip}, {"line", ch.spec.line}};
     channels.push_back(c);
@@ -47,7 +47,7 @@ nlohmann::json plan_json(const std::string& rig_name, const trigger::TimingPlan&
   for (const auto& s : plan.light_sources) {
     const auto limits = trigger::resolve_limits(s);
     sources.push_back({{"name", s.name},
-                       {"kind", trigger::to_string(s.kind)},
+                       {"kind", config::to_string(s.kind)},
                        {"pulse_width_us", us(s.pulse_width_ns)},
                        {"limits",
                         {{"max_pulse_width_us", us(limits.max_pulse_width_ns)},

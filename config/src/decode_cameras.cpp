@@ -19,13 +19,6 @@ namespace {
 // passes here can be sent, recorded and allocated.
 constexpr int kMaxImageSidePx = 1 << 16;
 
-constexpr Choice<CameraBackend> kCameraBackends[] = {
-    {"aravis", CameraBackend::aravis}, {"simulated", CameraBackend::simulated}, {"gentl", CameraBackend::gentl}};
-
-constexpr Choice<FrameMode> kFrameModes[] = {{"hardware", FrameMode::hardware},
-                                             {"two_triggers", FrameMode::two_triggers},
-                                             {"free_run", FrameMode::free_run}};
-
 // GenICam names of the exposure time; the timing plan writes it, so a verbatim one must agree.
 constexpr std::string_view kExposureFeatures[] = {"ExposureTime", "ExposureTimeAbs"};
 
@@ -81,7 +74,7 @@ void decode_camera(TableReader& r, const TriggerConfig& trigger, CameraConfig& c
   // Required, not defaulted: a rig that silently fell back to simulated cameras would
   // "record" synthetic images during a real run.
   CameraBackend backend{};
-  const bool backend_known = r.read_choice("backend", backend, kCameraBackends, Need::required);
+  const bool backend_known = r.read_choice("backend", backend, Need::required);
   if (backend_known) cam.backend = backend;
   const bool aravis = backend_known && backend == CameraBackend::aravis;
   const bool gentl = backend_known && backend == CameraBackend::gentl;
@@ -109,7 +102,7 @@ void decode_camera(TableReader& r, const TriggerConfig& trigger, CameraConfig& c
   decode_roi(r, simulated, cam.roi);
   decode_features(r, trigger.camera, cam.features);
 
-  if (r.read_choice("frame_mode", cam.frame_mode, kFrameModes)) {
+  if (r.read_choice("frame_mode", cam.frame_mode)) {
     if (cam.frame_mode == FrameMode::two_triggers && trigger.camera.readout_us <= 0.0)
       r.issue("frame_mode", "\"two_triggers\" needs the camera's readout time: add readout_us to [trigger.camera] (the "
                             "least time from the end of one exposure to the next trigger the camera takes, about "

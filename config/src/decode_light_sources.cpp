@@ -28,17 +28,18 @@ void read_limit(TableReader& r, std::string_view key, std::optional<double>& out
 void decode_light_source(TableReader& r, const TriggerConfig& t, bool dt_ok, LightSourceConfig& s) {
   r.read("name", s.name, Need::required, not_empty());
   // Optional: a source whose kind nobody stated gets the strictest limits of every kind.
-  r.read("kind", s.kind, Need::optional, one_of<std::string>({"laser", "led"}));
+  r.read_choice("kind", s.kind);
   s.pulse_width_us = t.pulse_width_us;
   const bool width_ok = r.read("pulse_width_us", s.pulse_width_us, Need::optional, positive_duration_us());
   // Two pulses of one source dt apart must not merge (as trigger.pulse_width_us).
   if (width_ok && dt_ok && s.pulse_width_us >= t.dt_us)
     r.issue("pulse_width_us", fmt::format("{} must be < trigger.dt_us ({})", s.pulse_width_us, t.dt_us));
 
-  if (r.read("flashlamp_lead_us", s.flashlamp_lead_us, Need::optional, non_negative_time_us()) && s.kind != "laser") {
+  if (r.read("flashlamp_lead_us", s.flashlamp_lead_us, Need::optional, non_negative_time_us()) && s.kind != LightSourceKind::laser) {
     r.issue("flashlamp_lead_us",
             fmt::format("only lasers have a flash lamp, but this source is {}: set kind = \"laser\" or remove the key",
-                        s.kind.empty() ? std::string("of no stated kind") : fmt::format("kind = \"{}\"", s.kind)));
+                        s.kind == LightSourceKind::unknown ? std::string("of no stated kind")
+                                                          : fmt::format("kind = \"{}\"", to_string(s.kind))));
     s.flashlamp_lead_us = 0.0;
   }
 

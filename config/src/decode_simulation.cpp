@@ -27,8 +27,8 @@ void decode_simulation(TableReader& root, std::optional<SimulationConfig>& simul
   r->read("read_noise_e", s.read_noise_e, Need::optional, at_least(0.0));
   const bool peak_ok =
       valid_or_absent(*r, "peak_counts", r->read("peak_counts", s.peak_counts, Need::optional, greater_than(0.0)));
-  r->read("light_sheet", s.light_sheet, Need::optional, one_of<std::string>({"uniform", "gaussian", "tophat"}));
-  r->read("spray", s.spray, Need::optional, one_of<std::string>({"jet-in-crossflow", "hollow-cone"}));
+  r->read_choice("light_sheet", s.light_sheet);
+  r->read_choice("spray", s.spray);
   r->read("pulse_b_energy", s.pulse_b_energy, Need::optional, in_left_open(0.0, 2.0));
   // A peak above full scale would clip every particle image.
   if (depth_ok && peak_ok) {

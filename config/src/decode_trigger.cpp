@@ -6,9 +6,6 @@
 namespace tomorig::config::detail {
 namespace {
 
-constexpr Choice<TriggerBackend> kTriggerBackends[] = {
-    {"gpio", TriggerBackend::gpio}, {"simulated", TriggerBackend::simulated}};
-
 // Userspace GPIO edges wait for the scheduler: even a PREEMPT_RT kernel has worst-case
 // wake-up latencies of tens of µs, so a finer resolution would be a promise the gpio device
 // cannot keep (it would then accept µs pulses it cannot time).
@@ -34,7 +31,7 @@ void decode_trigger(TableReader& root, TriggerConfig& t) {
   if (!r) return;
   // Required for the same reason as cameras[].backend: no silent fall-back to simulation.
   TriggerBackend backend{};
-  const bool backend_known = r->read_choice("backend", backend, kTriggerBackends, Need::required);
+  const bool backend_known = r->read_choice("backend", backend, Need::required);
   if (backend_known) t.backend = backend;
 
   const Rule<double> rate_rule{[](const double& v) -> std::optional<std::string> {

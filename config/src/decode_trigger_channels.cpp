@@ -26,8 +26,6 @@ struct ChannelContext {
   const std::vector<LightSourceConfig>* sources = nullptr;
 };
 
-bool drives_light(const std::string& role) { return role == "light" || role == "flashlamp"; }
-
 std::string declared_names(const std::vector<LightSourceConfig>& sources) {
   std::vector<std::string> names;
   for (const auto& s : sources)
@@ -35,27 +33,28 @@ std::string declared_names(const std::vector<LightSourceConfig>& sources) {
   return names.empty() ? std::string("none are declared") : fmt::format("declared: {}", fmt::join(names, ", "));
 }
 
-void decode_light_source_ref(TableReader& r, const ChannelContext& ctx, TriggerChannel& ch) {
+// `role_known`: the channel's role was read (else it was missing or invalid: already reported).
+void decode_light_source_ref(TableReader& r, const ChannelContext& ctx, bool role_known, TriggerChannel& ch) {
   const auto& sources = *ctx.sources;
   const bool present = r.has("light_source");
   const bool read_ok = r.read("light_source", ch.light_source, Need::optional, not_empty());
-  if (ch.role.empty()) return;  // role missing or invalid: already reported
+  if (!role_known) return;
   if (!drives_light(ch.role)) {
     if (present)
       r.issue("light_source", fmt::format("only light and flashlamp channels fire a light source, and this channel's role "
                                           "is \"{}\": remove the key",
-                                          ch.role));
+                                          to_string(ch.role)));
     ch.light_source.clear();
     return;
   }
   if (!present) {
     // Without declared sources a light channel is its own source (kind not stated: strictest
     // limits). A flash lamp must say which laser it pumps.
-    if (ch.role == "flashlamp" || !sources.empty())
+    if (ch.role == ChannelRole::flashlamp || !sources.empty())
       r.issue("light_source",
               fmt::format("required key is missing (expected a string naming a [[trigger.light_sources]] entry, {}){}",
                           declared_names(sources),
-                          ch.role == "flashlamp" ? ": a flashlamp channel fires the flash lamp of one laser" : ""));
+                          ch.role == ChannelRole::flashlamp ? ": a flashlamp channel fires the flash lamp of one laser" : ""));
     return;
   }
   if (!read_ok) return;
@@ -67,21 +66,22 @@ void decode_light_source_ref(TableReader& r, const ChannelContext& ctx, TriggerC
                                         ch.light_source, declared_names(sources)));
     return;
   }
-  if (ch.role == "flashlamp" && it->kind != "laser") {
-    const std::string kind = it->kind.empty() ? std::string("of no stated kind") : fmt::format("of kind \"{}\"", it->kind);
+  if (ch.role == ChannelRole::flashlamp && it->kind != LightSourceKind::laser) {
+    const std::string kind = it->kind == LightSourceKind::unknown ? std::string("of no stated kind")
+                                                                  : fmt::format("of kind \"{}\"", to_string(it->kind));
     r.issue("light_source", fmt::format("\"{}\" is {}, but a flashlamp channel fires the flash lamp of a laser: use a "
                                         "light source with kind = \"laser\"",
                                         ch.light_source, kind));
   }
 }
 
-void decode_timing_and_wiring(TableReader& r, const ChannelContext& ctx, TriggerChannel& ch) {
+void decode_timing_and_wiring(TableReader& r, const ChannelContext& ctx, bool role_known, TriggerChannel& ch) {
   const bool present = r.has("pulses");
-  r.read("pulses", ch.pulses, Need::optional, one_of<std::string>({"first", "second", "both"}));
-  if (present && !ch.role.empty() && !drives_light(ch.role))
+  r.read_choice("pulses", ch.pulses);
+  if (present && role_known && !drives_light(ch.role))
     r.issue("pulses", fmt::format("only light and flashlamp channels choose their pulses, and this channel's role is "
                                   "\"{}\": remove the key",
-                                  ch.role));
+                                  to_string(ch.role)));
   r.read("delay_us", ch.delay_us, Need::optional, non_negative_time_us());
   double width = 0.0;
   if (r.read("width_us", width, Need::optional, positive_duration_us())) ch.width_us = width;
@@ -89,7 +89,7 @@ void decode_timing_and_wiring(TableReader& r, const ChannelContext& ctx, Trigger
   // The gpio backend drives every channel itself, unless an external pulse generator makes
   // the µs timing: then only the generator's trigger input needs a GPIO line, and channels
   // without chip/line are the generator's outputs.
-  const bool must_be_wired = ctx.gpio && (!ctx.has_pulse_generator || ch.role == "pulse_generator");
+  const bool must_be_wired = ctx.gpio && (!ctx.has_pulse_generator || (role_known && ch.role == ChannelRole::pulse_generator));
   const bool has_chip = r.has("chip"), has_line = r.has("line");
   r.read("chip", ch.chip, Need::optional, not_empty());
   r.read("line", ch.line, Need::optional, at_least(0));
@@ -114,24 +114,24 @@ void decode_trigger_channels(TableReader& trigger, bool gpio, const std::vector<
   auto readers = trigger.array_of_tables("channels", gpio ? Need::required : Need::optional);
   // Roles first: whether a pulse generator exists decides which channels need GPIO wiring.
   std::vector<TriggerChannel> decoded(readers.size());
+  std::vector<bool> role_known(readers.size());
   for (std::size_t i = 0; i < readers.size(); ++i) {
     readers[i].read("name", decoded[i].name, Need::required, not_empty());
-    readers[i].read("role", decoded[i].role, Need::required,
-                    one_of<std::string>({"light", "camera", "flashlamp", "pulse_generator"}));
+    role_known[i] = readers[i].read_choice("role", decoded[i].role, Need::required);
   }
   ChannelContext ctx;
   ctx.gpio = gpio;
   ctx.sources = &sources;
   ctx.has_pulse_generator =
-      std::any_of(decoded.begin(), decoded.end(), [](const TriggerChannel& c) { return c.role == "pulse_generator"; });
+      std::any_of(decoded.begin(), decoded.end(), [](const TriggerChannel& c) { return c.role == ChannelRole::pulse_generator; });
 
   std::map<std::string, FirstUse> names;
   std::map<std::pair<std::string, int>, FirstUse> wires;
   for (std::size_t i = 0; i < readers.size(); ++i) {
     TableReader& r = readers[i];
     TriggerChannel& channel = decoded[i];
-    decode_light_source_ref(r, ctx, channel);
-    decode_timing_and_wiring(r, ctx, channel);
+    decode_light_source_ref(r, ctx, role_known[i], channel);
+    decode_timing_and_wiring(r, ctx, role_known[i], channel);
     r.report_unknown_keys();
     if (!channel.name.empty()) {
       auto [it, inserted] = names.try_emplace(channel.name, FirstUse{r.path(), r.line_of("name")});

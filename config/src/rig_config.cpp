@@ -102,30 +102,4 @@ const std::string& default_rig_toml() { return detail::embedded_default_rig_toml
 
 RigConfig default_rig_config() { return parse_rig_config(default_rig_toml(), "default-rig.toml"); }
 
-std::string_view to_string(CameraBackend b) {
-  switch (b) {
-    case CameraBackend::aravis: return "aravis";
-    case CameraBackend::simulated: return "simulated";
-    case CameraBackend::gentl: return "gentl";
-  }
-  return "unknown";
-}
-
-std::string_view to_string(TriggerBackend b) {
-  switch (b) {
-    case TriggerBackend::gpio: return "gpio";
-    case TriggerBackend::simulated: return "simulated";
-  }
-  return "unknown";
-}
-
-std::string_view to_string(FrameMode m) {
-  switch (m) {
-    case FrameMode::hardware: return "hardware";
-    case FrameMode::two_triggers: return "two_triggers";
-    case FrameMode::free_run: return "free_run";
-  }
-  return "unknown";
-}
-
 }  // namespace tomorig::config

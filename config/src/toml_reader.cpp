@@ -260,4 +260,10 @@ void TableReader::report_unknown_keys() {
   }
 }
 
+std::string unknown_word_message(std::string_view word, const std::vector<std::string>& allowed) {
+  std::string message = fmt::format("\"{}\" must be one of {}", word, fmt::join(allowed, ", "));
+  if (auto suggestion = closest_match(word, allowed)) message += fmt::format(", did you mean \"{}\"?", *suggestion);
+  return message;
+}
+
 }  // namespace tomorig::config::detail

@@ -21,12 +21,6 @@ namespace tomorig::config::detail {
 
 enum class Need { optional, required };
 
-template <typename E>
-struct Choice {
-  std::string_view name;
-  E value;
-};
-
 class TableReader {
  public:
   // `path` is the table's key path ("" for the document root).
@@ -46,9 +40,10 @@ class TableReader {
   bool read(std::string_view key, bool& out, Need need = Need::optional);
   // An array of exactly out.size() numbers, e.g. origin_mm = [0, 0, 0].
   bool read_numbers(std::string_view key, std::span<double> out, Need need = Need::optional);
-  // A string naming one of `choices`; the message lists them.
-  template <typename E, std::size_t N>
-  bool read_choice(std::string_view key, E& out, const Choice<E> (&choices)[N], Need need = Need::optional);
+  // A string naming a value of E (rig_vocabulary.h); an unknown word's message names the key,
+  // the word, the allowed words and the closest one.
+  template <HasVocabulary E>
+  bool read_choice(std::string_view key, E& out, Need need = Need::optional);
   // A string, number or boolean as text (GenICam features are passed on verbatim).
   bool read_as_text(std::string_view key, std::string& out);
 
@@ -81,19 +76,20 @@ inline bool valid_or_absent(const TableReader& r, std::string_view key, bool rea
   return read_ok || !r.has(key);
 }
 
-template <typename E, std::size_t N>
-bool TableReader::read_choice(std::string_view key, E& out, const Choice<E> (&choices)[N], Need need) {
+// "\"third\" must be one of first, second, both[, did you mean \"both\"?]"
+std::string unknown_word_message(std::string_view word, const std::vector<std::string>& allowed);
+
+template <HasVocabulary E>
+bool TableReader::read_choice(std::string_view key, E& out, Need need) {
   std::string name;
   if (!read(key, name, need)) return false;
-  for (const auto& c : choices) {
-    if (c.name == name) {
-      out = c.value;
-      return true;
-    }
+  if (const auto value = parse<E>(name)) {
+    out = *value;
+    return true;
   }
-  std::vector<std::string_view> names;
-  for (const auto& c : choices) names.push_back(c.name);
-  issue(key, fmt::format("\"{}\" must be one of {}", name, fmt::join(names, ", ")));
+  std::vector<std::string> allowed;
+  for (const auto& w : Vocabulary<E>::words) allowed.emplace_back(w.name);
+  issue(key, unknown_word_message(name, allowed));
   return false;
 }
 

@@ -8,13 +8,14 @@
 #include <fmt/core.h>
 #include <zmq.hpp>
 
-#include "tomorig/core/console.h"
 #include "tomorig/core/error.h"
 #include "tomorig/rig/send_with_retry.h"
 #include "tomorig/rig/stop_signal.h"
 #include "tomorig/storage/session_file.h"
 #include "tomorig/stream/frame_sender.h"
 #include "tomorig/stream/session_messages.h"
+
+#include "rate_status_line.h"
 
 namespace tomorig::rig {
 namespace {
@@ -25,34 +26,22 @@ using std::chrono::duration_cast;
 
 double seconds_since(Clock::time_point t) { return duration<double>(Clock::now() - t).count(); }
 
-// One status line on stderr (StatusLine: redrawn on a terminal, a line every few seconds in a log).
+// "replay: 12 sets sent  9.9 sets/s  41.9 MB/s  0 blocked sends": redrawn on a terminal, a
+// plain line every few seconds into a log.
 class ReplayStatus {
  public:
-  explicit ReplayStatus(bool enabled) : enabled_(enabled), last_(Clock::now()) {}
+  explicit ReplayStatus(bool enabled) : line_(enabled) {}
 
   void update(const stream::SenderStats& s, std::uint64_t blocked_sets, bool final = false) {
-    if (!enabled_ || (!final && !line_.due())) return;
-    const auto now = Clock::now();
-    const double dt = duration<double>(now - last_).count();
-    const double rate = dt > 0 ? static_cast<double>(s.sets_sent - last_sets_) / dt : 0.0;
-    const double mbps = dt > 0 ? static_cast<double>(s.bytes_sent - last_bytes_) / dt / 1e6 : 0.0;
-    const std::string text = fmt::format("replay: {} sets sent  {:.1f} sets/s  {:.1f} MB/s  {} blocked sends",
-                                         s.sets_sent, rate, mbps, blocked_sets);
-    if (final) line_.finish(text);
-    else line_.update(text);
-    last_ = now;
-    last_sets_ = s.sets_sent;
-    last_bytes_ = s.bytes_sent;
+    line_.update(s.sets_sent, s.bytes_sent, final, [&](const RateStatusLine::Rates& rates) {
+      return fmt::format("replay: {} sets sent  {:.1f} sets/s  {:.1f} MB/s  {} blocked sends", s.sets_sent,
+                         rates.sets_per_second, rates.mb_per_second, blocked_sets);
+    });
   }
-  void break_line() {
-    if (enabled_) line_.break_line();
-  }
+  void break_line() { line_.break_line(); }
 
  private:
-  bool enabled_;
-  StatusLine line_;
-  Clock::time_point last_;
-  std::uint64_t last_sets_ = 0, last_bytes_ = 0;
+  RateStatusLine line_;
 };
 
 // Waits until `due`; true if a stop was asked for meanwhile.

@@ -27,6 +27,16 @@ std::string human_bytes(std::uintmax_t bytes) {
   return fmt::format("{} B", bytes);
 }
 
+// The rig file's profile (config's word) as the simulator's own enum.
+sim::LightSheetProfile sim_light_sheet(config::LightSheetProfile profile) {
+  switch (profile) {
+    case config::LightSheetProfile::uniform: return sim::LightSheetProfile::uniform;
+    case config::LightSheetProfile::gaussian: return sim::LightSheetProfile::gaussian;
+    case config::LightSheetProfile::tophat: return sim::LightSheetProfile::tophat;
+  }
+  return sim::LightSheetProfile::uniform;
+}
+
 }  // namespace
 
 storage::TruthCamera truth_camera_of(const std::string& id, const calibration::PinholeCamera& model, int width,
@@ -68,11 +78,7 @@ sim::SimulationOptions simulation_options_from(const config::RigConfig& rig) {
   o.noise = s.noise;
   o.read_noise_e = s.read_noise_e;
   o.peak_counts = s.peak_counts;
-  const auto sheet = sim::parse_light_sheet_profile(s.light_sheet);
-  if (!sheet)
-    throw bad_input(fmt::format("simulation.light_sheet = \"{}\" is unknown: use one of {}", s.light_sheet,
-                                sim::light_sheet_profiles()));
-  o.light_sheet = *sheet;
+  o.light_sheet = sim_light_sheet(s.light_sheet);
   o.rate_hz = rig.trigger.rate_hz;
   o.dt_ns = std::llround(rig.trigger.dt_us * 1000.0);
 

@@ -218,4 +218,18 @@ std::string write_spray_session(const sim::SprayOptions& options, int sets, cons
                      seconds);
 }
 
+sim::SprayPattern sim_spray_pattern(config::SprayPattern pattern) {
+  switch (pattern) {
+    case config::SprayPattern::jet_in_crossflow: return sim::SprayPattern::jet_in_crossflow;
+    case config::SprayPattern::hollow_cone: return sim::SprayPattern::hollow_cone;
+  }
+  return sim::SprayPattern::jet_in_crossflow;
+}
+
+sim::SprayPattern parse_spray_pattern(const std::string& word, const std::string& option) {
+  if (const auto pattern = config::parse<config::SprayPattern>(word)) return sim_spray_pattern(*pattern);
+  throw bad_input(fmt::format("{} {}: unknown spray pattern, use one of {}", option, word,
+                              config::allowed_words<config::SprayPattern>()));
+}
+
 }  // namespace tomorig::rig

@@ -10,6 +10,7 @@
 
 #include "simulate_spray_truth.h"
 #include "tomorig/core/error.h"
+#include "tomorig/rig/simulate_spray.h"
 #include "tomorig/rig/simulated_scene.h"
 
 namespace tomorig::rig {
@@ -58,7 +59,7 @@ sim::SprayOptions spray_options_from(const config::RigConfig& rig) {
   sim::SprayOptions o;
   o.reduced = reduced;
   o.seed = s.seed;
-  o.pattern = sim::parse_spray_pattern(s.spray);
+  o.pattern = sim_spray_pattern(s.spray);
   o.noise = s.noise;
   o.pulse_b_energy = s.pulse_b_energy;
   o.dt_us = rig.trigger.dt_us;

@@ -7,11 +7,12 @@
 #include <fmt/core.h>
 #include <zmq.hpp>
 
-#include "tomorig/core/console.h"
 #include "tomorig/core/error.h"
 #include "tomorig/rig/stop_signal.h"
 #include "tomorig/rig/stream_session.h"
 #include "tomorig/stream/receive_memory.h"
+
+#include "rate_status_line.h"
 
 namespace tomorig::rig {
 namespace {
@@ -26,35 +27,23 @@ constexpr std::chrono::milliseconds kReceivePoll{250};
 // flood the terminal.
 constexpr std::uint64_t kPrintedRefusals = 10;
 
-// "record: 12 sets  41.9 MB/s to disk  0 lost sets  0 refused  0 rejected" on a StatusLine:
-// redrawn on a terminal, a plain line every few seconds into a log.
+// "record: 12 sets  41.9 MB/s to disk  0 lost sets  0 refused  0 rejected": redrawn on a
+// terminal, a plain line every few seconds into a log.
 class RecordStatus {
  public:
-  explicit RecordStatus(bool enabled) : enabled_(enabled), last_(Clock::now()) {}
+  explicit RecordStatus(bool enabled) : line_(enabled) {}
 
   void update(const RecorderReport& c, std::uint64_t rejected, const stream::ReceiverStats& r, bool final = false) {
-    if (!enabled_ || (!final && !line_.due())) return;
-    const auto now = Clock::now();
-    const double dt = duration<double>(now - last_).count();
-    const double mbps = dt > 0 ? static_cast<double>(c.bytes - last_bytes_) / dt / 1e6 : 0.0;
-    // ZeroMQ does not expose its queue, so the status shows what the recorder can count.
-    const std::string text = fmt::format("record: {} sets  {:.1f} MB/s to disk  {} lost sets  {} refused  {} rejected",
-                                         c.written, mbps, r.sets_missing, c.refused, rejected);
-    if (final) line_.finish(text);
-    else line_.update(text);
-    last_ = now;
-    last_bytes_ = c.bytes;
+    line_.update(c.written, c.bytes, final, [&](const RateStatusLine::Rates& rates) {
+      // ZeroMQ does not expose its queue, so the status shows what the recorder can count.
+      return fmt::format("record: {} sets  {:.1f} MB/s to disk  {} lost sets  {} refused  {} rejected", c.written,
+                         rates.mb_per_second, r.sets_missing, c.refused, rejected);
+    });
   }
-  // Ends a line rewritten in place, so another message starts on a fresh line.
-  void break_line() {
-    if (enabled_) line_.break_line();
-  }
+  void break_line() { line_.break_line(); }
 
  private:
-  bool enabled_;
-  StatusLine line_;
-  Clock::time_point last_;
-  std::uint64_t last_bytes_ = 0;
+  RateStatusLine line_;
 };
 
 }  // namespace

@@ -5,23 +5,6 @@
 
 namespace tomorig::sim {
 
-std::string_view to_string(LightSheetProfile profile) {
-  switch (profile) {
-    case LightSheetProfile::uniform: return "uniform";
-    case LightSheetProfile::gaussian: return "gaussian";
-    case LightSheetProfile::tophat: return "tophat";
-  }
-  return "unknown";
-}
-
-std::optional<LightSheetProfile> parse_light_sheet_profile(std::string_view name) {
-  for (auto p : {LightSheetProfile::uniform, LightSheetProfile::gaussian, LightSheetProfile::tophat})
-    if (name == to_string(p)) return p;
-  return std::nullopt;
-}
-
-std::string light_sheet_profiles() { return "uniform, gaussian, tophat"; }
-
 LightSheet LightSheet::for_slab(LightSheetProfile profile, const Slab& slab) {
   LightSheet sheet;
   sheet.profile = profile;

@@ -36,12 +36,6 @@ double normal(std::mt19937_64& rng) {
 
 }  // namespace
 
-SprayPattern parse_spray_pattern(const std::string& name) {
-  if (name == "hollow-cone") return SprayPattern::hollow_cone;
-  if (name == "jet-in-crossflow") return SprayPattern::jet_in_crossflow;
-  throw bad_input(fmt::format("spray pattern '{}' is unknown: use hollow-cone or jet-in-crossflow", name));
-}
-
 std::string to_string(SprayPattern p) { return p == SprayPattern::hollow_cone ? "hollow-cone" : "jet-in-crossflow"; }
 
 void SprayOptions::validate() const {

@@ -121,7 +121,7 @@ TEST(DefaultRig, HasTheTpivThesisGridTriggerAndScene) {
   EXPECT_EQ(sim.bit_depth, 16);
   EXPECT_FALSE(sim.noise);
   EXPECT_DOUBLE_EQ(sim.peak_counts, 1000.0);
-  EXPECT_EQ(sim.light_sheet, "uniform");
+  EXPECT_EQ(sim.light_sheet, LightSheetProfile::uniform);
 }
 
 TEST(DefaultRig, KnowsItsSimulationCase) {
@@ -208,7 +208,7 @@ iterations = 20
   EXPECT_EQ(rig.trigger.backend, TriggerBackend::gpio);
   ASSERT_EQ(rig.trigger.channels.size(), 2u);
   EXPECT_EQ(rig.trigger.channels[0].name, "laser1");
-  EXPECT_EQ(rig.trigger.channels[0].role, "light");
+  EXPECT_EQ(rig.trigger.channels[0].role, ChannelRole::light);
   EXPECT_EQ(rig.trigger.channels[0].chip, "gpiochip0");
   EXPECT_EQ(rig.trigger.channels[1].line, 18);
   ASSERT_TRUE(rig.calibration_file.has_value());

@@ -95,7 +95,7 @@ role = "camera"
   ASSERT_EQ(t.light_sources.size(), 2u);
   const LightSourceConfig& head = t.light_sources[0];
   EXPECT_EQ(head.name, "head1");
-  EXPECT_EQ(head.kind, "laser");
+  EXPECT_EQ(head.kind, LightSourceKind::laser);
   EXPECT_DOUBLE_EQ(head.pulse_width_us, 0.008);  // from trigger.pulse_width_us
   EXPECT_DOUBLE_EQ(head.flashlamp_lead_us, 180.0);
   EXPECT_FALSE(head.max_pulse_width_us.has_value());
@@ -103,23 +103,23 @@ role = "camera"
   ASSERT_TRUE(head.max_rate_hz.has_value());
   EXPECT_DOUBLE_EQ(*head.max_rate_hz, 15.0);
   const LightSourceConfig& led = t.light_sources[1];
-  EXPECT_EQ(led.kind, "led");
+  EXPECT_EQ(led.kind, LightSourceKind::led);
   EXPECT_DOUBLE_EQ(led.pulse_width_us, 0.4);
   EXPECT_DOUBLE_EQ(led.max_pulse_width_us.value_or(0), 1.5);
   EXPECT_DOUBLE_EQ(led.max_duty_cycle.value_or(0), 0.0005);
   EXPECT_FALSE(led.max_rate_hz.has_value());
 
   ASSERT_EQ(t.channels.size(), 5u);
-  EXPECT_EQ(t.channels[0].role, "pulse_generator");
+  EXPECT_EQ(t.channels[0].role, ChannelRole::pulse_generator);
   EXPECT_DOUBLE_EQ(t.channels[0].delay_us, 0.085);
   EXPECT_EQ(t.channels[0].chip, "gpiochip0");
   EXPECT_EQ(t.channels[0].line, 5);
-  EXPECT_EQ(t.channels[1].role, "flashlamp");
+  EXPECT_EQ(t.channels[1].role, ChannelRole::flashlamp);
   EXPECT_EQ(t.channels[1].light_source, "head1");
-  EXPECT_EQ(t.channels[1].pulses, "first");
+  EXPECT_EQ(t.channels[1].pulses, PulseSelect::first);
   EXPECT_DOUBLE_EQ(t.channels[1].width_us.value_or(0), 10.0);
   EXPECT_DOUBLE_EQ(t.channels[2].delay_us, 0.1);
-  EXPECT_EQ(t.channels[3].pulses, "both");  // the default
+  EXPECT_EQ(t.channels[3].pulses, PulseSelect::both);  // the default
   EXPECT_FALSE(t.channels[3].width_us.has_value());
   // With a pulse generator, channels without chip/line are the generator's outputs.
   EXPECT_TRUE(t.channels[4].chip.empty());
@@ -134,7 +134,7 @@ TEST(TriggerConfig, KeysLeftOutTakeTheirDefaults) {
   EXPECT_DOUBLE_EQ(t.camera.interframe_us, 0.12);
   EXPECT_DOUBLE_EQ(t.camera.exposure_b_us, 1000.0);
   ASSERT_EQ(t.light_sources.size(), 1u);
-  EXPECT_EQ(t.light_sources[0].kind, "");  // not stated: the trigger's strictest limits
+  EXPECT_EQ(t.light_sources[0].kind, LightSourceKind::unknown);  // not stated: the trigger's strictest limits
   EXPECT_DOUBLE_EQ(t.light_sources[0].pulse_width_us, 0.01);
   EXPECT_DOUBLE_EQ(t.light_sources[0].flashlamp_lead_us, 0.0);
 }

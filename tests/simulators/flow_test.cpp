@@ -78,8 +78,6 @@ TEST(LightSheet, Profiles) {
   EXPECT_NEAR(t.intensity(0), 1.0, 1e-9);
   EXPECT_NEAR(t.intensity(1.5), 0.5, 1e-6);
   EXPECT_LT(t.intensity(2.0), 1e-3);
-  EXPECT_EQ(tomorig::sim::parse_light_sheet_profile("tophat"), LightSheetProfile::tophat);
-  EXPECT_FALSE(tomorig::sim::parse_light_sheet_profile("laser").has_value());
 }
 
 }  // namespace

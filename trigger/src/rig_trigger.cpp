@@ -9,29 +9,10 @@ namespace {
 
 std::int64_t us_to_ns(double us) { return std::llround(us * 1000.0); }
 
-LightSourceKind kind_of(const std::string& kind) {
-  if (kind == "laser") return LightSourceKind::laser;
-  if (kind == "led") return LightSourceKind::led;
-  return LightSourceKind::unknown;  // not stated: the strictest limits of every kind
-}
-
-ChannelRole role_of(const std::string& role) {
-  if (role == "light") return ChannelRole::light;
-  if (role == "flashlamp") return ChannelRole::flashlamp;
-  if (role == "pulse_generator") return ChannelRole::pulse_generator;
-  return ChannelRole::camera;
-}
-
-PulseSelect pulses_of(const std::string& pulses) {
-  if (pulses == "first") return PulseSelect::first;
-  if (pulses == "second") return PulseSelect::second;
-  return PulseSelect::both;
-}
-
 LightSource light_source(const config::LightSourceConfig& s) {
   LightSource out;
   out.name = s.name;
-  out.kind = kind_of(s.kind);
+  out.kind = s.kind;
   out.pulse_width_ns = us_to_ns(s.pulse_width_us);
   out.flashlamp_lead_ns = us_to_ns(s.flashlamp_lead_us);
   if (s.max_pulse_width_us) out.limits.max_pulse_width_ns = us_to_ns(*s.max_pulse_width_us);
@@ -78,12 +59,12 @@ RigTrigger rig_trigger(const config::RigConfig& rig) {
   for (const auto& ch : t.channels) {
     ChannelSpec c;
     c.name = ch.name;
-    c.role = role_of(ch.role);
+    c.role = ch.role;
     c.chip = ch.chip;
     c.line = ch.line;
     c.delay_ns = us_to_ns(ch.delay_us);
     if (c.role == ChannelRole::light || c.role == ChannelRole::flashlamp) {
-      c.pulses = pulses_of(ch.pulses);
+      c.pulses = ch.pulses;
       c.light_source = ch.light_source.empty() ? ch.name : ch.light_source;
       if (ch.light_source.empty()) out.inputs.light_sources.push_back(own_light_source(ch.name, t.pulse_width_us));
     }

@@ -85,15 +85,6 @@ std::string channel_list(const std::vector<std::string>& names) {
 
 }  // namespace
 
-std::string_view to_string(LightSourceKind kind) {
-  switch (kind) {
-    case LightSourceKind::laser: return "laser";
-    case LightSourceKind::led: return "led";
-    case LightSourceKind::unknown: return "unknown";
-  }
-  return "?";
-}
-
 ResolvedLimits default_limits(LightSourceKind kind) {
   switch (kind) {
     case LightSourceKind::laser: return kLaser;

@@ -211,25 +211,6 @@ std::string_view to_string(FrameMode mode) {
   return mode == FrameMode::two_triggers ? "two_triggers" : "hardware";
 }
 
-std::string_view to_string(ChannelRole role) {
-  switch (role) {
-    case ChannelRole::camera: return "camera";
-    case ChannelRole::light: return "light";
-    case ChannelRole::flashlamp: return "flashlamp";
-    case ChannelRole::pulse_generator: return "pulse_generator";
-  }
-  return "?";
-}
-
-std::string_view to_string(PulseSelect pulses) {
-  switch (pulses) {
-    case PulseSelect::first: return "first";
-    case PulseSelect::second: return "second";
-    case PulseSelect::both: return "both";
-  }
-  return "?";
-}
-
 const ChannelTiming* TimingPlan::find_channel(std::string_view name) const {
   for (const auto& c : channels)
     if (c.spec.name == name) return &c;

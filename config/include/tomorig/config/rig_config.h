@@ -10,19 +10,10 @@
 #include <string>
 #include <vector>
 
+#include "tomorig/config/rig_vocabulary.h"
 #include "tomorig/core/pixel_format.h"
 
 namespace tomorig::config {
-
-enum class CameraBackend : std::uint8_t { aravis, simulated, gentl };
-enum class TriggerBackend : std::uint8_t { gpio, simulated };
-
-// How a camera makes the two frames of a set (docs/configuration.md, frame_mode).
-enum class FrameMode : std::uint8_t {
-  hardware,      // one trigger, two frames: a PIV double-shutter camera
-  two_triggers,  // a single-frame camera, triggered at pulse 1 and again at pulse 2
-  free_run,      // not triggered: frames are unsynchronised, no set is ever complete
-};
 
 struct Roi {
   int offset_x = 0, offset_y = 0;
@@ -52,7 +43,7 @@ struct CameraConfig {
 // for the kind (docs/trigger.md).
 struct LightSourceConfig {
   std::string name;                 // unique, e.g. "laser1", "led_cam0"
-  std::string kind;                 // "laser" | "led"; empty: not stated (strictest limits of every kind)
+  LightSourceKind kind = LightSourceKind::unknown;  // "laser" | "led"; unknown: not stated (strictest limits)
   double pulse_width_us = 0.01;     // optical pulse width; default: trigger.pulse_width_us
   double flashlamp_lead_us = 0.0;   // lasers: flash lamp -> Q-switch delay
   std::optional<double> max_pulse_width_us;  // safety limits; see docs/configuration.md for bounds
@@ -62,10 +53,10 @@ struct LightSourceConfig {
 
 struct TriggerChannel {
   std::string name;           // e.g. "laser1", "cam_trigger"
-  std::string role;           // "light" | "camera" | "flashlamp" | "pulse_generator"
+  ChannelRole role = ChannelRole::camera;  // required in the file: "light" | "camera" | "flashlamp" | "pulse_generator"
   std::string light_source;   // light and flashlamp channels: a LightSourceConfig::name; empty:
                               // (light, no [[trigger.light_sources]]) the channel is its own source
-  std::string pulses = "both";  // light and flashlamp channels: "first" | "second" | "both"
+  PulseSelect pulses = PulseSelect::both;  // light and flashlamp channels: "first" | "second" | "both"
   double delay_us = 0.0;      // edge -> effect: camera latency, LED rise time, Q-switch build-up
   std::optional<double> width_us;  // electrical pulse width; unset: the trigger module's default
   std::string chip;           // GPIO chip for the gpio backend, e.g. "gpiochip0"
@@ -120,10 +111,10 @@ struct SimulationConfig {
   bool noise = false;             // shot + read noise
   double read_noise_e = 5.0;      // electrons, 1 sigma
   double peak_counts = 1000.0;    // peak intensity of a particle image
-  std::string light_sheet = "uniform";  // "uniform" | "gaussian" | "tophat"
+  LightSheetProfile light_sheet = LightSheetProfile::uniform;  // "uniform" | "gaussian" | "tophat"
   // spray-thesis only (docs/spray.md): the droplet pattern, and LED pulse B's energy relative
   // to pulse A (1: equal; 0.8: a 20 % drop, which the spray quick-look flags).
-  std::string spray = "jet-in-crossflow";  // "jet-in-crossflow" | "hollow-cone"
+  SprayPattern spray = SprayPattern::jet_in_crossflow;  // "jet-in-crossflow" | "hollow-cone"
   double pulse_b_energy = 1.0;
 };
 
@@ -206,8 +197,6 @@ RigConfig default_rig_config();
 // The simulator's built-in cases ([simulation] case), as defined in ../shared/benchmarks.
 const std::vector<std::string>& simulation_case_names();
 
-std::string_view to_string(CameraBackend b);
-std::string_view to_string(TriggerBackend b);
-std::string_view to_string(FrameMode m);
+// to_string / parse of the enums: rig_vocabulary.h.
 
 }  // namespace tomorig::config

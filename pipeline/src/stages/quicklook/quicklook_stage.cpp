@@ -265,7 +265,7 @@ class QuickLookStage final : public Stage {
     const config::RigConfig* rig = recording.rig_config();
     if (rig == nullptr || rig->trigger.light_sources.empty()) return false;
     for (const config::LightSourceConfig& source : rig->trigger.light_sources)
-      if (source.kind != "led") return false;
+      if (source.kind != config::LightSourceKind::led) return false;
     return true;
   }
 

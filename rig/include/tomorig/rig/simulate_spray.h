@@ -11,10 +11,17 @@
 #include <functional>
 #include <string>
 
+#include "tomorig/config/rig_vocabulary.h"
 #include "tomorig/simulators/spray.h"
 #include "tomorig/storage/session_file.h"
 
 namespace tomorig::rig {
+
+// The rig file's spray pattern ([simulation] spray, config's word) as the simulator's enum.
+sim::SprayPattern sim_spray_pattern(config::SprayPattern pattern);
+// A pattern named in config's words ("hollow-cone", "jet-in-crossflow"), e.g. `simulate
+// --spray`; bad_input naming `option`, the word and the allowed words.
+sim::SprayPattern parse_spray_pattern(const std::string& word, const std::string& option);
 
 // The optics set-up of a case as the TOML `tomorig optics visibility --setup` reads.
 std::string spray_optics_setup_toml(const sim::SprayCase& c);

@@ -14,10 +14,8 @@ enum class LightSheetProfile {
   gaussian,  // exp(-dz^2 / 2 s^2) with 4 s = thickness: the slab faces get 13.5 %
   tophat,    // flat inside, erf edges of width `edge_mm` (1 sigma), 50 % at the slab faces
 };
-std::string_view to_string(LightSheetProfile profile);
-std::optional<LightSheetProfile> parse_light_sheet_profile(std::string_view name);
-// "uniform, gaussian, tophat": for error messages that say what is allowed.
-std::string light_sheet_profiles();
+// The rig file's words for the profiles ([simulation] light_sheet) are config's
+// (config::LightSheetProfile); rig/ maps one onto the other.
 
 struct LightSheet {
   LightSheetProfile profile = LightSheetProfile::uniform;

@@ -28,8 +28,8 @@
 namespace tomorig::sim {
 
 enum class SprayPattern { hollow_cone, jet_in_crossflow };
-// "hollow-cone" | "jet-in-crossflow"; throws bad_input naming the choices.
-SprayPattern parse_spray_pattern(const std::string& name);
+// "hollow-cone" | "jet-in-crossflow" (the truth's flow name); the words a user writes are
+// config's (config::SprayPattern), which rig/ maps onto this enum.
 std::string to_string(SprayPattern p);
 
 struct SprayOptions {

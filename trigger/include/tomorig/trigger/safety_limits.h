@@ -9,18 +9,16 @@
 #include <string_view>
 #include <vector>
 
+#include "tomorig/config/rig_vocabulary.h"
+
 namespace tomorig::trigger {
 
 struct TimingPlan;
 struct LightSource;
 
-enum class LightSourceKind : std::uint8_t {
-  laser,    // Q-switched (flash-lamp pumped) laser head
-  led,      // current-pulsed, usually overdriven LED
-  unknown,  // not said: the strictest limit of every kind applies
-};
-
-std::string_view to_string(LightSourceKind kind);
+// laser, led, or unknown (not said: the strictest limit of every kind applies); the rig file's
+// words and to_string() are config's (rig_vocabulary.h).
+using LightSourceKind = config::LightSourceKind;
 
 // Unset fields take the built-in default of the source's kind (default_limits()).
 struct SafetyLimits {

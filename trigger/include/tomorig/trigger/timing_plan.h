@@ -19,12 +19,9 @@
 
 namespace tomorig::trigger {
 
-enum class ChannelRole : std::uint8_t {
-  camera,           // exposure trigger of a double-frame camera (one trigger: frames A and B)
-  light,            // the edge that makes light: LED driver input, laser Q-switch
-  flashlamp,        // a laser head's flash lamp, fired `flashlamp_lead_ns` before its Q-switch
-  pulse_generator,  // trigger input of an external delay generator that makes the µs pulses
-};
+// camera, light, flashlamp, pulse_generator: what an output drives. Its words and to_string()
+// are the rig file's (config/rig_vocabulary.h).
+using ChannelRole = config::ChannelRole;
 
 // How the triggered cameras make frames A and B.
 enum class FrameMode : std::uint8_t {
@@ -34,11 +31,8 @@ enum class FrameMode : std::uint8_t {
 std::string_view to_string(FrameMode mode);
 
 // Which of the two straddled pulses a light (or flash-lamp) channel makes: one head of a
-// dual-cavity laser makes one, an LED makes both.
-enum class PulseSelect : std::uint8_t { first, second, both };
-
-std::string_view to_string(ChannelRole role);
-std::string_view to_string(PulseSelect pulses);
+// dual-cavity laser makes one, an LED makes both (first, second, both; config/rig_vocabulary.h).
+using PulseSelect = config::PulseSelect;
 
 // A light source: what the safety limits and pulse widths belong to. Several channels may
 // refer to one source (a laser head's flash lamp and Q-switch).
