@@ -294,7 +294,6 @@ Image render_spray_chessboard_target(const SprayCase& c, std::size_t camera, dou
   const double level = c.options.bright_fraction * 65535.0;
   const double energy = pulse_energy(c, kBrightStream, frame + 2000003, camera, 1);
   constexpr double kChromium = 0.05;
-  constexpr double kBoardHalfMm = 6.0;
   const double cs = std::cos(rotation_deg * M_PI / 180.0), sn = std::sin(rotation_deg * M_PI / 180.0);
   // The image-space PSF at this depth, as a droplet there gets it (project() above).
   const Vec3d centre{0.0, 0.0, z_mm};
@@ -341,13 +340,10 @@ Image render_spray_chessboard_target(const SprayCase& c, std::size_t camera, dou
             const double fu = (q + 0.5) / kSub - 0.5, fv = (j + 0.5) / kSub - 0.5;
             const double s = s0 + fu * su + fv * sv, t = t0 + fu * tu + fv * tv;
             // Each board line blurred on its own ((2 Phi - 1) of the distance in pixels / sigma),
-            // the board their product; inside the board only (a clear frame around it).
+            // the board their product (exact away from the corners); 1 on the clear squares.
             const double bs = std::erf(signed_distance(s) / s_mm_per_px * k);
             const double bt = std::erf(signed_distance(t) / t_mm_per_px * k);
-            const double inside_s = 0.5 * (std::erf((kBoardHalfMm - std::abs(s)) / s_mm_per_px * k) + 1.0);
-            const double inside_t = 0.5 * (std::erf((kBoardHalfMm - std::abs(t)) / t_mm_per_px * k) + 1.0);
-            const double board = 0.5 * (1.0 + bs * bt);  // 1 on the clear squares
-            sum += 1.0 - inside_s * inside_t * (1.0 - board);
+            sum += 0.5 * (1.0 + bs * bt);
           }
         mask = kChromium + (1.0 - kChromium) * sum / (kSub * kSub);
       }

@@ -109,17 +109,25 @@ TEST_F(OpticsCli, PredictedSetupLimitAgreesWithSimulatedVisibility) {
 }
 
 TEST_F(OpticsCli, PsfFromSimulatedTargetsMatchesTheTruthWithin5Percent) {
-  // Acceptance of issue 20: the simulated PSF half-widths are recovered within 5 % at every depth.
+  // Acceptance of issue 20: the simulated PSF half-widths are recovered within 5 % at every
+  // depth. The product path of thesis Sect. 6.4: chessboard images of 13 depths, back-projected
+  // through the cameras onto voxel planes, flat-fielded, edge spread -> line spread -> Gaussian.
   const std::string session = (dir_ / "targets.h5").string();
   const CliResult sim = run_tomorig("simulate --case spray-thesis --targets --reduced --seed 3 --out " + shell_quoted(session));
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
-  const CliResult psf = run_tomorig("optics psf --session " + shell_quoted(session) + " --json");
+  const std::string psf_file = (dir_ / "psf.toml").string(), png = (dir_ / "psf.png").string();
+  const CliResult psf = run_tomorig("optics psf " + shell_quoted(session) + " --calib truth --json --psf-out " +
+                                    shell_quoted(psf_file) + " --png " + shell_quoted(png));
   ASSERT_EQ(psf.exit_code, 0) << psf.err;
   const nlohmann::json measured = nlohmann::json::parse(psf.out);
   storage::SessionReader reader(session);
   const nlohmann::json truth = nlohmann::json::parse(reader.truth().flow_parameters);
   ASSERT_EQ(measured["cameras"].size(), 4u);
   ASSERT_EQ(truth["cameras"].size(), 4u);
+  EXPECT_EQ(measured["method"], "voxel");
+  const double voxel_mm = measured["plane"]["voxel_mm"];
+  EXPECT_GT(voxel_mm, 0.025);  // about one voxel per pixel (26 um / M 0.85-0.95)
+  EXPECT_LT(voxel_mm, 0.032);
   for (std::size_t c = 0; c < 4; ++c) {
     const auto& m = measured["cameras"][c];
     const auto& t = truth["cameras"][c];
@@ -129,13 +137,22 @@ TEST_F(OpticsCli, PsfFromSimulatedTargetsMatchesTheTruthWithin5Percent) {
       EXPECT_DOUBLE_EQ(m["z_mm"][k].get<double>(), t["z_mm"][k].get<double>());
       EXPECT_NEAR(m["chi_um"][k].get<double>() / t["chi_um"][k].get<double>(), 1.0, 0.05)
           << t["id"] << " at z = " << t["z_mm"][k];
+      // The back-projection's interpolation widens the spread in the voxel planes.
+      EXPECT_GT(m["chi_voxel_um"][k].get<double>(), m["chi_um"][k].get<double>());
     }
   }
+  // The PSF file the reconstruction reads holds the same numbers, and the plot is there.
+  const std::string psf_text = read_text_file(psf_file);
+  EXPECT_NE(psf_text.find("sigma_px = ["), std::string::npos) << psf_text;
+  EXPECT_NE(psf_text.find("id = \"cam4\""), std::string::npos) << psf_text;
+  const Image plot = storage::read_image(png);
+  EXPECT_EQ(plot.width(), 900);
+
   // The measured chi feeds the visibility table: the set-up file it writes gives (nearly) the
   // limits of the true set-up.
   const std::string measured_setup = (dir_ / "measured.toml").string();
-  const CliResult out = run_tomorig("optics psf --session " + shell_quoted(session) + " --setup-out " +
-                                    shell_quoted(measured_setup) + " --f-number 22 --noise 0.010,0.006,0.006,0.010");
+  const CliResult out = run_tomorig("optics psf " + shell_quoted(session) + " --setup-out " + shell_quoted(measured_setup) +
+                                    " --f-number 22 --noise 0.010,0.006,0.006,0.010");
   ASSERT_EQ(out.exit_code, 0) << out.err;
   const std::string true_setup = (dir_ / "true.toml").string();
   std::ofstream(true_setup) << truth["optics_setup_toml"].get<std::string>();
@@ -148,15 +165,45 @@ TEST_F(OpticsCli, PsfFromSimulatedTargetsMatchesTheTruthWithin5Percent) {
   for (std::size_t k = 0; k < ja["rows"].size(); ++k)
     EXPECT_NEAR(ja["rows"][k]["setup_d_min_um"].get<double>() / jb["rows"][k]["setup_d_min_um"].get<double>(), 1.0, 0.05)
         << "z = " << ja["rows"][k]["z_mm"];
-  // Not replaced without --overwrite.
-  const CliResult again = run_tomorig("optics psf --session " + shell_quoted(session) + " --setup-out " +
+
+  // Outputs are not replaced without --overwrite, and are left as they were.
+  const CliResult again = run_tomorig("optics psf " + shell_quoted(session) + " --setup-out " +
                                       shell_quoted(measured_setup) + " --f-number 22 --noise 0.01");
   EXPECT_EQ(again.exit_code, 2);
+  const CliResult again_psf = run_tomorig("optics psf " + shell_quoted(session) + " --psf-out " + shell_quoted(psf_file));
+  EXPECT_EQ(again_psf.exit_code, 2);
+  EXPECT_NE(again_psf.err.find("overwrite"), std::string::npos) << again_psf.err;
+  EXPECT_EQ(read_text_file(psf_file), psf_text);
 
-  // A depth list that does not match the sets is refused with exit 2.
-  const CliResult no_z = run_tomorig("optics psf --session " + shell_quoted(session) + " --z 1,2");
+  // A depth list that does not match the sets is refused with exit 2, and so is a plane the
+  // cameras do not see.
+  const CliResult no_z = run_tomorig("optics psf " + shell_quoted(session) + " --z 1,2");
   EXPECT_EQ(no_z.exit_code, 2);
   EXPECT_NE(no_z.err.find("--z"), std::string::npos) << no_z.err;
+  const CliResult far = run_tomorig("optics psf " + shell_quoted(session) + " --grid 100,100,1,0.03,60,0,0");
+  EXPECT_EQ(far.exit_code, 2);  // every image fails: nothing measured
+  EXPECT_NE(far.err.find("--grid"), std::string::npos) << far.err;
+}
+
+TEST_F(OpticsCli, ReconstructReadsTheMeasuredPsfFile) {
+  // `reconstruct --psf` takes each camera's sigma over depth from the file `optics psf` writes.
+  const std::string session = (dir_ / "spray.h5").string();
+  ASSERT_EQ(run_tomorig("simulate --case spray-thesis --reduced --sets 1 --seed 2 --out " + shell_quoted(session)).exit_code, 0);
+  const std::string psf_file = (dir_ / "psf.toml").string();
+  std::string text = "voxel_mm = 0.03\n";
+  for (int c = 1; c <= 4; ++c)
+    text += "[[cameras]]\nid = \"cam" + std::to_string(c) +
+            "\"\nz_mm = [-4.5, 0, 4.5]\nchi_um = [60, 42, 60]\nchi_voxel_um = [66, 48, 66]\nsigma_px = [1.0, 0.7, 1.0]\n";
+  std::ofstream(psf_file) << text;
+  const std::string volume = (dir_ / "v.h5").string();
+  const std::string common = " --calib truth --algorithm mlos --grid 40,40,20,0.2 -o " + shell_quoted(volume) + " --overwrite";
+  const CliResult ok = run_tomorig("reconstruct " + shell_quoted(session) + " --psf " + shell_quoted(psf_file) + common);
+  EXPECT_EQ(ok.exit_code, 0) << ok.err;
+  std::ofstream(psf_file) << "voxel_mm = 0.03\n[[cameras]]\nid = \"cam1\"\nz_mm = [0]\nchi_um = [42]\n"
+                             "chi_voxel_um = [48]\nsigma_px = [0.7]\n";
+  const CliResult missing = run_tomorig("reconstruct " + shell_quoted(session) + " --psf " + shell_quoted(psf_file) + common);
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find("'cam2'"), std::string::npos) << missing.err;
 }
 
 TEST_F(OpticsCli, RefusesBadInputWithExitCode2) {

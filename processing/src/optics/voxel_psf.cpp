@@ -138,6 +138,51 @@ Image flat_field_chessboard(const Image& plane_image, double square_px) {
   return out;
 }
 
+VoxelPlane common_view_plane(const std::vector<const calibration::CameraModel*>& cameras,
+                             const std::vector<ImageSize>& sizes, const std::vector<double>& z_mm) {
+  if (cameras.empty() || cameras.size() != sizes.size() || z_mm.empty())
+    throw bad_input("voxel plane: needs the cameras, their image sizes and at least one depth");
+  const auto [zlo, zhi] = std::minmax_element(z_mm.begin(), z_mm.end());
+  const double zmid = 0.5 * (*zlo + *zhi);
+  const auto seen = [&](double x, double y) {
+    for (std::size_t c = 0; c < cameras.size(); ++c)
+      for (double z : z_mm) {
+        const Vec2d uv = cameras[c]->project({x, y, z});
+        if (!(uv.x >= 1 && uv.y >= 1 && uv.x <= sizes[c].width - 2 && uv.y <= sizes[c].height - 2)) return false;
+      }
+    return true;
+  };
+  // One pixel in object space: 1 / the largest singular value of the image Jacobian.
+  double voxel = 1e9;
+  for (const calibration::CameraModel* cam : cameras) {
+    const double h = 0.01;
+    const Vec2d a = cam->project({h, 0, zmid}), b = cam->project({-h, 0, zmid});
+    const Vec2d c = cam->project({0, h, zmid}), d = cam->project({0, -h, zmid});
+    const double ux = (a.x - b.x) / (2 * h), vx = (a.y - b.y) / (2 * h), uy = (c.x - d.x) / (2 * h), vy = (c.y - d.y) / (2 * h);
+    const double m00 = ux * ux + vx * vx, m01 = ux * uy + vx * vy, m11 = uy * uy + vy * vy;
+    const double largest = std::sqrt(0.5 * (m00 + m11) + std::sqrt(0.25 * (m00 - m11) * (m00 - m11) + m01 * m01));
+    if (largest > 0 && std::isfinite(largest)) voxel = std::min(voxel, 1.0 / largest);
+  }
+  if (!(voxel < 1e9)) throw bad_input("voxel plane: a camera does not image the z axis");
+  // Shrink a square until its border is seen by every camera at every depth.
+  double half = 0.0;
+  for (double h = 50.0; h > 20 * voxel; h *= 0.95) {
+    bool ok = true;
+    for (int i = 0; i <= 8 && ok; ++i) {
+      const double t = -h + i * h / 4.0;
+      ok = seen(t, -h) && seen(t, h) && seen(-h, t) && seen(h, t);
+    }
+    if (ok) {
+      half = 0.9 * h;
+      break;
+    }
+  }
+  if (half == 0.0)
+    throw bad_input("voxel plane: the cameras share no view of the z axis at these depths: give the plane (--grid)");
+  const int n = static_cast<int>(2.0 * half / voxel);
+  return {-0.5 * (n - 1) * voxel, -0.5 * (n - 1) * voxel, 0.0, voxel, n, n};
+}
+
 VoxelPsf measure_voxel_psf(const Image& image, const calibration::CameraModel& camera, const VoxelPlane& plane,
                            SpreadAxis axis) {
   // edge_psf.h measures edges running down the columns: the spread along y needs the board

@@ -28,7 +28,7 @@ TEST(VoxelPsf, RecoversTheSimulatedHalfWidthAtEveryDepthWithin5Percent) {
   o.seed = 23;
   const sim::SprayCase c = sim::make_spray_thesis_case(o);
   double worst = 0;
-  for (std::size_t ci : {std::size_t{0}, std::size_t{2}}) {  // cam1 (-45 deg, f 105), cam3 (+25 deg, f 200)
+  for (std::size_t ci : {std::size_t{2}}) {  // cam3 (+25 deg, f 200): the CLI test checks all four
     const sim::SprayCamera& cam = c.cameras[ci];
     for (std::size_t k = 0; k < cam.chi.size(); ++k) {
       const double z = cam.chi[k].z_mm;
@@ -47,7 +47,7 @@ TEST(VoxelPsf, RecoversTheSimulatedHalfWidthAtEveryDepthWithin5Percent) {
                   cam.chi[k].chi_um, psf.chi_um, psf.chi_voxel_um, psf.edges);
     }
   }
-  std::printf("worst chi error over 2 cameras x 13 depths: %.2f %%\n", 100 * worst);
+  std::printf("worst chi error over 13 depths: %.2f %%\n", 100 * worst);
 }
 
 TEST(VoxelPsf, FinerVoxelsSpreadLessInThePlaneButGiveTheSameCameraPsf) {

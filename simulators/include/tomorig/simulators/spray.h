@@ -116,7 +116,7 @@ Image render_spray_edge_target(const SprayCase& c, std::size_t camera, double z_
                                double slant_deg = 4.0);
 // A chessboard calibration image for the knife-edge PSF in voxel space (Sect. 6.4, 7.3.3): a
 // back-lit photomask chessboard of `square_mm` squares (clear / chromium at 5 % transmission)
-// covering |x|, |y| <= 6 mm of the plane z = z_mm (clear glass around it), its lines turned by
+// filling the view on the plane z = z_mm, its lines turned by
 // `rotation_deg` from the world x and y axes (a real board is never aligned exactly; the turn
 // lets the edges sample every sub-voxel phase), a square corner at the origin; seen through
 // camera c's PSF at that depth (the blur and pixel integration the droplets get), with the

@@ -13,6 +13,8 @@
 //   psf.chi_voxel_um   // Fig. 6.15 / 7.9's quantity
 //   psf.chi_um         // the camera's PSF (optics + pixel), object um: for the visibility model
 //   psf.sigma_px()     // the reconstruction's weight sigma in pixels (psf_model.h)
+#include <vector>
+
 #include "tomorig/core/image.h"
 
 namespace tomorig::calibration {
@@ -45,6 +47,17 @@ Image back_project_plane(const Image& image, const calibration::CameraModel& cam
 // bilinearly between them - the thesis's Kriging of the square centres, for a slowly varying
 // back light. Throws bad_input if a window has no contrast.
 Image flat_field_chessboard(const Image& plane_image, double square_px);
+
+struct ImageSize {
+  int width = 0, height = 0;
+};
+
+// The default plane: the largest square centred on the z axis that every camera sees at every
+// depth (with a 10 % margin), at about one voxel per pixel (the finest camera's object pixel at
+// the middle depth; the thesis's 60 voxel/mm). z is left 0. Throws bad_input if the cameras
+// share no view of the axis.
+VoxelPlane common_view_plane(const std::vector<const calibration::CameraModel*>& cameras,
+                             const std::vector<ImageSize>& sizes, const std::vector<double>& z_mm);
 
 struct VoxelPsf {
   double chi_voxel_um = 0;  // LSF half-width in the voxel plane, as measured, along the spread
