@@ -7,12 +7,14 @@
 #include <cmath>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.h"
 #include "tomorig/storage/image_file.h"
 #include "tomorig/storage/session_file.h"
+#include "tomorig/storage/volume_file.h"
 
 namespace tomorig::testing {
 namespace {
@@ -116,8 +118,10 @@ TEST_F(OpticsCli, PsfFromSimulatedTargetsMatchesTheTruthWithin5Percent) {
   const CliResult sim = run_tomorig("simulate --case spray-thesis --targets --reduced --seed 3 --out " + shell_quoted(session));
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
   const std::string psf_file = (dir_ / "psf.toml").string(), png = (dir_ / "psf.png").string();
+  const std::string measured_setup = (dir_ / "measured.toml").string();
   const CliResult psf = run_tomorig("optics psf " + shell_quoted(session) + " --calib truth --json --psf-out " +
-                                    shell_quoted(psf_file) + " --png " + shell_quoted(png));
+                                    shell_quoted(psf_file) + " --png " + shell_quoted(png) + " --setup-out " +
+                                    shell_quoted(measured_setup) + " --f-number 22 --noise 0.010,0.006,0.006,0.010");
   ASSERT_EQ(psf.exit_code, 0) << psf.err;
   const nlohmann::json measured = nlohmann::json::parse(psf.out);
   storage::SessionReader reader(session);
@@ -148,12 +152,8 @@ TEST_F(OpticsCli, PsfFromSimulatedTargetsMatchesTheTruthWithin5Percent) {
   const Image plot = storage::read_image(png);
   EXPECT_EQ(plot.width(), 900);
 
-  // The measured chi feeds the visibility table: the set-up file it writes gives (nearly) the
+  // The measured chi feeds the visibility table: the set-up file it wrote gives (nearly) the
   // limits of the true set-up.
-  const std::string measured_setup = (dir_ / "measured.toml").string();
-  const CliResult out = run_tomorig("optics psf " + shell_quoted(session) + " --setup-out " + shell_quoted(measured_setup) +
-                                    " --f-number 22 --noise 0.010,0.006,0.006,0.010");
-  ASSERT_EQ(out.exit_code, 0) << out.err;
   const std::string true_setup = (dir_ / "true.toml").string();
   std::ofstream(true_setup) << truth["optics_setup_toml"].get<std::string>();
   const CliResult a = run_tomorig("optics visibility --json --setup " + shell_quoted(measured_setup));
@@ -186,24 +186,36 @@ TEST_F(OpticsCli, PsfFromSimulatedTargetsMatchesTheTruthWithin5Percent) {
 }
 
 TEST_F(OpticsCli, ReconstructReadsTheMeasuredPsfFile) {
-  // `reconstruct --psf` takes each camera's sigma over depth from the file `optics psf` writes.
-  const std::string session = (dir_ / "spray.h5").string();
-  ASSERT_EQ(run_tomorig("simulate --case spray-thesis --reduced --sets 1 --seed 2 --out " + shell_quoted(session)).exit_code, 0);
+  // `reconstruct --psf` takes each camera's sigma over depth from the file `optics psf` writes
+  // (cameras matched by id) and records the file with the volume.
+  const std::string session = (dir_ / "s.h5").string();
+  ASSERT_EQ(run_tomorig("simulate --sets 1 --ppp 0.01 --seed 3 -o " + shell_quoted(session)).exit_code, 0);
+  std::vector<std::string> ids;
+  {
+    const storage::SessionReader reader(session);
+    for (const storage::SessionCamera& c : reader.info().cameras) ids.push_back(c.id);
+  }
+  ASSERT_GE(ids.size(), 2u);
   const std::string psf_file = (dir_ / "psf.toml").string();
   std::string text = "voxel_mm = 0.03\n";
-  for (int c = 1; c <= 4; ++c)
-    text += "[[cameras]]\nid = \"cam" + std::to_string(c) +
-            "\"\nz_mm = [-4.5, 0, 4.5]\nchi_um = [60, 42, 60]\nchi_voxel_um = [66, 48, 66]\nsigma_px = [1.0, 0.7, 1.0]\n";
+  for (const std::string& id : ids)
+    text += "[[cameras]]\nid = \"" + id +
+            "\"\nz_mm = [-4.5, 0, 4.5]\nchi_um = [60, 42, 60]\nchi_voxel_um = [66, 48, 66]\nsigma_px = [0.9, 0.6, 0.9]\n";
   std::ofstream(psf_file) << text;
   const std::string volume = (dir_ / "v.h5").string();
-  const std::string common = " --calib truth --algorithm mlos --grid 40,40,20,0.2 -o " + shell_quoted(volume) + " --overwrite";
+  const std::string common = " --algorithm mlos -o " + shell_quoted(volume) + " --overwrite";
   const CliResult ok = run_tomorig("reconstruct " + shell_quoted(session) + " --psf " + shell_quoted(psf_file) + common);
-  EXPECT_EQ(ok.exit_code, 0) << ok.err;
-  std::ofstream(psf_file) << "voxel_mm = 0.03\n[[cameras]]\nid = \"cam1\"\nz_mm = [0]\nchi_um = [42]\n"
-                             "chi_voxel_um = [48]\nsigma_px = [0.7]\n";
+  ASSERT_EQ(ok.exit_code, 0) << ok.err;
+  const nlohmann::json parameters = nlohmann::json::parse(storage::VolumeFileReader(volume).info().parameters_json);
+  EXPECT_EQ(parameters["psf"], psf_file);
+  EXPECT_TRUE(parameters["sigma_px"].is_null());
+
+  // A file without one of the session's cameras is refused, naming it.
+  std::ofstream(psf_file) << "voxel_mm = 0.03\n[[cameras]]\nid = \"" + ids[0] +
+                                 "\"\nz_mm = [0]\nchi_um = [42]\nchi_voxel_um = [48]\nsigma_px = [0.7]\n";
   const CliResult missing = run_tomorig("reconstruct " + shell_quoted(session) + " --psf " + shell_quoted(psf_file) + common);
   EXPECT_EQ(missing.exit_code, 2);
-  EXPECT_NE(missing.err.find("'cam2'"), std::string::npos) << missing.err;
+  EXPECT_NE(missing.err.find("'" + ids[1] + "'"), std::string::npos) << missing.err;
 }
 
 TEST_F(OpticsCli, RefusesBadInputWithExitCode2) {
