@@ -19,6 +19,48 @@
 namespace tomorig::testing {
 namespace {
 
+// The set-up limit of a visibility table (`optics visibility --json`) against a simulated spray
+// session's visible truth (set 0: bit c of visible_mask, the droplet's own rendered shadow
+// reaches camera c's threshold), for droplets in all four views more than 15 % from the limit
+// (closer, the pixel phase decides).
+struct Agreement {
+  int compared = 0, agree = 0;
+  double min_limit = 0, edge_limit = 0;  // in focus, and the larger at the two ends
+};
+
+Agreement agreement_with_visible_truth(const std::string& session, const nlohmann::json& table) {
+  storage::SessionReader reader(session);
+  const nlohmann::json truth = nlohmann::json::parse(reader.truth().flow_parameters);
+  const storage::TruthSet positions = reader.truth_set(0);
+  const nlohmann::json& set = truth["sets"][0];
+  std::vector<double> z, limit;
+  for (const auto& row : table["rows"]) {
+    z.push_back(row["z_mm"]);
+    limit.push_back(row["setup_d_min_um"].is_null() ? 1e9 : row["setup_d_min_um"].get<double>());
+  }
+  Agreement out;
+  out.min_limit = *std::min_element(limit.begin(), limit.end());
+  out.edge_limit = std::max(limit.front(), limit.back());
+  const auto limit_at = [&](double zz) {
+    zz = std::clamp(zz, z.front(), z.back());
+    std::size_t i = 1;
+    while (i + 1 < z.size() && z[i] < zz) ++i;
+    const double t = (zz - z[i - 1]) / (z[i] - z[i - 1]);
+    return limit[i - 1] + t * (limit[i] - limit[i - 1]);
+  };
+  for (std::size_t n = 0; n < positions.particles_a.size(); ++n) {
+    const double d = set["d_um"][n];
+    bool in_all_views = true;
+    for (const auto& m : set["min_intensity"][n]) in_all_views = in_all_views && m.get<double>() < 1.0;
+    const double lim = limit_at(positions.particles_a[n].z);
+    if (!in_all_views || std::abs(d / lim - 1.0) < 0.15) continue;
+    const bool visible = set["visible_mask"][n].get<int>() == 15;
+    ++out.compared;
+    out.agree += (d >= lim) == visible;
+  }
+  return out;
+}
+
 class OpticsCli : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -75,35 +117,13 @@ TEST_F(OpticsCli, PredictedSetupLimitAgreesWithSimulatedVisibility) {
   ASSERT_EQ(vis.exit_code, 0) << vis.err;
   const nlohmann::json table = nlohmann::json::parse(vis.out);
   ASSERT_EQ(table["rows"].size(), 13u);
-  std::vector<double> z, limit;
-  for (const auto& row : table["rows"]) {
-    z.push_back(row["z_mm"]);
-    limit.push_back(row["setup_d_min_um"].is_null() ? 1e9 : row["setup_d_min_um"].get<double>());
-  }
+  const Agreement a = agreement_with_visible_truth(session, table);
   // The thesis's figure (Fig. 7.10): ~10 um in focus, up to ~20 um at the volume's edges.
-  EXPECT_GT(*std::min_element(limit.begin(), limit.end()), 6.0);
-  EXPECT_LT(*std::min_element(limit.begin(), limit.end()), 13.0);
-  EXPECT_GT(std::max(limit.front(), limit.back()), 12.0);
-  const auto limit_at = [&](double zz) {
-    zz = std::clamp(zz, z.front(), z.back());
-    std::size_t i = 1;
-    while (i + 1 < z.size() && z[i] < zz) ++i;
-    const double t = (zz - z[i - 1]) / (z[i] - z[i - 1]);
-    return limit[i - 1] + t * (limit[i] - limit[i - 1]);
-  };
-  int compared = 0, agree = 0;
-  for (std::size_t n = 0; n < positions.particles_a.size(); ++n) {
-    const double d = set["d_um"][n];
-    bool in_all_views = true;
-    for (const auto& m : set["min_intensity"][n]) in_all_views = in_all_views && m.get<double>() < 1.0;
-    const double lim = limit_at(positions.particles_a[n].z);
-    if (!in_all_views || std::abs(d / lim - 1.0) < 0.15) continue;
-    const bool visible = set["visible_mask"][n].get<int>() == 15;
-    ++compared;
-    agree += (d >= lim) == visible;
-  }
-  ASSERT_GT(compared, 200);
-  EXPECT_GE(agree, 0.98 * compared) << agree << " of " << compared;
+  EXPECT_GT(a.min_limit, 6.0);
+  EXPECT_LT(a.min_limit, 13.0);
+  EXPECT_GT(a.edge_limit, 12.0);
+  ASSERT_GT(a.compared, 200);
+  EXPECT_GE(a.agree, 0.98 * a.compared) << a.agree << " of " << a.compared;
 
   const Image plot = storage::read_image(png);
   EXPECT_EQ(plot.width(), 900);
@@ -165,6 +185,13 @@ TEST_F(OpticsCli, PsfFromSimulatedTargetsMatchesTheTruthWithin5Percent) {
   for (std::size_t k = 0; k < ja["rows"].size(); ++k)
     EXPECT_NEAR(ja["rows"][k]["setup_d_min_um"].get<double>() / jb["rows"][k]["setup_d_min_um"].get<double>(), 1.0, 0.05)
         << "z = " << ja["rows"][k]["z_mm"];
+  // ... and the curve predicted from the measured PSF agrees with which droplets a simulated
+  // spray's rendered images show (the whole chain: chessboards -> PSF -> visibility -> truth).
+  const std::string spray = (dir_ / "spray.h5").string();
+  ASSERT_EQ(run_tomorig("simulate --case spray-thesis --reduced --sets 1 --seed 5 --out " + shell_quoted(spray)).exit_code, 0);
+  const Agreement agreement = agreement_with_visible_truth(spray, ja);
+  ASSERT_GT(agreement.compared, 200);
+  EXPECT_GE(agreement.agree, 0.98 * agreement.compared) << agreement.agree << " of " << agreement.compared;
 
   // Outputs are not replaced without --overwrite, and are left as they were.
   const CliResult again = run_tomorig("optics psf " + shell_quoted(session) + " --setup-out " +
