@@ -334,6 +334,16 @@ Image render_spray_chessboard_target(const SprayCase& c, std::size_t camera, dou
         const double su = s_at[i + 1] - s0, sv = s_at[i + w + 1] - s0;
         const double tu = t_at[i + 1] - t0, tv = t_at[i + w + 1] - t0;
         const double s_mm_per_px = std::hypot(su, sv), t_mm_per_px = std::hypot(tu, tv);
+        // Far from every line (the pixel's reach plus 6 sigma: erf = 1 to 1e-8) the board is
+        // its plain colour; only the pixels near a line need the blurred sub-samples.
+        const double ds = signed_distance(s0), dt = signed_distance(t0);
+        const double reach_s = 0.5 * (std::abs(su) + std::abs(sv)) + 6.0 * sigma_px * s_mm_per_px;
+        const double reach_t = 0.5 * (std::abs(tu) + std::abs(tv)) + 6.0 * sigma_px * t_mm_per_px;
+        if (std::abs(ds) > reach_s && std::abs(dt) > reach_t) {
+          mask = (ds > 0) == (dt > 0) ? 1.0 : kChromium;
+          row[x] = static_cast<float>(energy * bright_field(cam, level, c.options.vignetting, x, y) * mask);
+          continue;
+        }
         double sum = 0.0;
         for (int j = 0; j < kSub; ++j)
           for (int q = 0; q < kSub; ++q) {
