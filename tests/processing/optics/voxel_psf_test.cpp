@@ -66,6 +66,22 @@ TEST(VoxelPsf, FinerVoxelsGiveTheSameCameraPsf) {
   EXPECT_NEAR(one.chi_um / sim::spray_chi_um(cam, 0.0), 1.0, 0.05);
 }
 
+TEST(VoxelPsf, AcrossTheOtherLinesThePlaneStretchesButTheCameraPsfIsTheSame) {
+  // cam1 looks 45 deg off the z axis about y: along x the plane is foreshortened by cos 45,
+  // so the back-projected spread is about 1.4 x wider there; the camera's PSF is not.
+  sim::SprayOptions o;
+  o.reduced = true;
+  o.seed = 5;
+  const sim::SprayCase c = sim::make_spray_thesis_case(o);
+  const sim::SprayCamera& cam = c.cameras[0];
+  for (double z : {0.0, 4.5}) {
+    const Image img = sim::render_spray_chessboard_target(c, 0, z, 0);
+    const VoxelPsf x = measure_voxel_psf(img, cam.pinhole, centre_plane(cam, z), SpreadAxis::x);
+    EXPECT_NEAR(x.chi_um / sim::spray_chi_um(cam, z), 1.0, 0.05) << "z " << z;
+    EXPECT_GT(x.chi_voxel_um, 1.25 * x.chi_um) << "z " << z;
+  }
+}
+
 TEST(VoxelPsf, RefusesAPlaneOutsideTheImageAndAPlaneWithoutABoard) {
   sim::SprayOptions o;
   o.reduced = true;
