@@ -2,10 +2,12 @@
 //   tomorig optics visibility --setup optics.toml [--json] [--png plot.png] [--overwrite]
 //   tomorig optics visibility --f-number 22 --magnification 0.9 --chi -4.5:62,0:40,4.5:60 --noise 0.01
 //   tomorig optics transmission --f-number 22 --magnification 0.9 --d 5,10,20,50 [--chi 40]
-//   tomorig optics psf --session targets.h5 [--z LIST] [--magnification LIST] [--json]
+//   tomorig optics psf targets.h5 [--calib truth|FILE] [--grid G] [--z LIST] [--json] [--png P] [--psf-out psf.toml]
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,8 +22,12 @@
 #include "tomorig/processing/optics/droplet_image.h"
 #include "tomorig/processing/optics/edge_psf.h"
 #include "tomorig/processing/optics/optics_setup.h"
+#include "tomorig/processing/optics/psf_plot.h"
+#include "tomorig/processing/optics/psf_table.h"
 #include "tomorig/processing/optics/visibility.h"
 #include "tomorig/processing/optics/visibility_plot.h"
+#include "tomorig/processing/optics/voxel_psf.h"
+#include "tomorig/pipeline/session_geometry.h"
 #include "tomorig/storage/image_file.h"
 #include "tomorig/storage/output_path.h"
 #include "tomorig/storage/session_file.h"
@@ -208,42 +214,26 @@ void run_transmission(const OpticsArgs& a) {
 
 struct PsfArgs {
   std::string session, z, magnification;
+  std::string method = "voxel", calib, grid, axis = "y";
+  std::string png, psf_out;
   std::string setup_out, noise, liquid = "kerosene";
   double f_number = 0;
   JsonOutput json;
   bool overwrite = false;
 };
 
-double object_pixel_um(const storage::SessionReader& reader, const std::vector<double>& magnification, std::size_t c,
-                       double z_mm);
+// One camera's results over the session's depths (NaN: not measured).
+struct PsfColumn {
+  std::vector<double> chi_um, chi_voxel_um, sigma_px, object_pixel_um;
+  std::vector<int> edges;
+  explicit PsfColumn(std::size_t depths)
+      : chi_um(depths, std::nan("")), chi_voxel_um(depths, std::nan("")), sigma_px(depths, std::nan("")),
+        object_pixel_um(depths, std::nan("")), edges(depths, 0) {}
+};
 
-// The measured chi as a set-up file for `tomorig optics visibility --setup` (docs/spray.md).
-std::string setup_toml(const PsfArgs& a, const storage::SessionReader& reader, const std::vector<double>& magnification,
-                       const std::vector<double>& z, const std::vector<std::vector<double>>& chi) {
-  const std::size_t cams = chi.size();
-  std::vector<double> noise;
-  for (const std::string& t : split(a.noise, ',')) noise.push_back(number(t, "--noise"));
-  if (noise.size() == 1) noise.assign(cams, noise[0]);
-  if (noise.size() != cams) throw bad_input(fmt::format("--noise: give one value, or one per camera ({})", cams));
-  std::string t = fmt::format("# PSF half-widths measured by `tomorig optics psf` on {}.\nliquid = \"{}\"\n", a.session,
-                              optics::Liquid::named(a.liquid).name);
-  for (std::size_t c = 0; c < cams; ++c) {
-    std::string zs, chis;
-    for (std::size_t k = 0; k < z.size(); ++k) {
-      if (!std::isfinite(chi[c][k])) continue;  // a depth without a measurable edge
-      zs += (zs.empty() ? "" : ", ") + fmt::format("{}", z[k]);
-      chis += (chis.empty() ? "" : ", ") + fmt::format("{:.2f}", chi[c][k]);
-    }
-    // The magnification at z = 0 (from the truth camera, or the one given).
-    const double m = reader.info().cameras[c].pixel_pitch_um / object_pixel_um(reader, magnification, c, 0.0);
-    t += fmt::format("\n[[cameras]]\nid = \"{}\"\nf_number = {}\nmagnification = {:.4f}\nnoise = {}\nz_mm = [{}]\nchi_um = [{}]\n",
-                     reader.info().cameras[c].id, a.f_number, m, noise[c], zs, chis);
-  }
-  return t;
-}
-
-// Object-space size (um) of one pixel of camera c at depth z: from the session's truth camera
-// (pinhole: depth along the axis / fx) when there is one, else pixel pitch / magnification.
+// Object-space size (um) of one pixel of camera c at depth z for the in-image method: from the
+// session's truth camera (pinhole: depth along the axis / fx) when there is one, else pixel
+// pitch / magnification.
 double object_pixel_um(const storage::SessionReader& reader, const std::vector<double>& magnification, std::size_t c,
                        double z_mm) {
   if (!magnification.empty()) return reader.info().cameras[c].pixel_pitch_um / magnification[c];
@@ -253,18 +243,74 @@ double object_pixel_um(const storage::SessionReader& reader, const std::vector<d
   return depth / t.K[0] * 1000.0;
 }
 
-void run_psf(const PsfArgs& a) {
-  if (!a.setup_out.empty()) {
-    storage::check_output_path(a.setup_out, a.overwrite, "set-up");
-    if (!(a.f_number > 0) || a.noise.empty())
-      throw bad_input("--setup-out needs --f-number and --noise (sigma of the flat-fielded bright field, one or one "
-                      "per camera) to describe the cameras");
+// The object pixel at the depth nearest z = 0 (for the set-up file's magnification).
+double object_pixel_near_focus(const std::vector<double>& z, const PsfColumn& col) {
+  double best = std::nan(""), dz = 1e300;
+  for (std::size_t k = 0; k < z.size(); ++k)
+    if (std::isfinite(col.object_pixel_um[k]) && std::abs(z[k]) < dz) {
+      dz = std::abs(z[k]);
+      best = col.object_pixel_um[k];
+    }
+  return best;
+}
+
+// The measured chi as a set-up file for `tomorig optics visibility --setup` (docs/spray.md).
+std::string setup_toml(const PsfArgs& a, const storage::SessionReader& reader, const std::vector<double>& z,
+                       const std::vector<PsfColumn>& cols) {
+  const std::size_t cams = cols.size();
+  std::vector<double> noise;
+  for (const std::string& t : split(a.noise, ',')) noise.push_back(number(t, "--noise"));
+  if (noise.size() == 1) noise.assign(cams, noise[0]);
+  if (noise.size() != cams) throw bad_input(fmt::format("--noise: give one value, or one per camera ({})", cams));
+  std::string t = fmt::format("# PSF half-widths measured by `tomorig optics psf` on {}.\nliquid = \"{}\"\n", a.session,
+                              optics::Liquid::named(a.liquid).name);
+  for (std::size_t c = 0; c < cams; ++c) {
+    std::string zs, chis;
+    for (std::size_t k = 0; k < z.size(); ++k) {
+      if (!std::isfinite(cols[c].chi_um[k])) continue;  // a depth without a measurable edge
+      zs += (zs.empty() ? "" : ", ") + fmt::format("{}", z[k]);
+      chis += (chis.empty() ? "" : ", ") + fmt::format("{:.2f}", cols[c].chi_um[k]);
+    }
+    if (zs.empty()) throw runtime_error(fmt::format("camera '{}': no depth was measured", reader.info().cameras[c].id));
+    const double m = reader.info().cameras[c].pixel_pitch_um / object_pixel_near_focus(z, cols[c]);
+    t += fmt::format("\n[[cameras]]\nid = \"{}\"\nf_number = {}\nmagnification = {:.4f}\nnoise = {}\nz_mm = [{}]\nchi_um = [{}]\n",
+                     reader.info().cameras[c].id, a.f_number, m, noise[c], zs, chis);
   }
-  cli::require_session(a.session, "optics psf");
-  const storage::SessionReader reader(a.session);
-  const std::size_t sets = reader.set_count(), cams = reader.info().cameras.size();
-  if (sets == 0) throw bad_input(fmt::format("session '{}' has no sets: record one target image per depth", a.session));
-  std::vector<double> z, m;
+  return t;
+}
+
+// The PSF file the reconstruction reads (`reconstruct --psf`), measured depths only.
+optics::PsfTable psf_table(const storage::SessionReader& reader, const optics::VoxelPlane& plane, const std::string& axis,
+                           const std::vector<double>& z, const std::vector<PsfColumn>& cols) {
+  optics::PsfTable t;
+  t.voxel_mm = plane.voxel_mm;
+  t.axis = axis;
+  for (std::size_t c = 0; c < cols.size(); ++c) {
+    optics::PsfTableCamera cam;
+    cam.id = reader.info().cameras[c].id;
+    for (std::size_t k = 0; k < z.size(); ++k) {
+      if (!std::isfinite(cols[c].chi_um[k])) continue;
+      cam.z_mm.push_back(z[k]);
+      cam.chi_um.push_back(cols[c].chi_um[k]);
+      cam.chi_voxel_um.push_back(cols[c].chi_voxel_um[k]);
+      cam.sigma_px.push_back(cols[c].sigma_px[k]);
+    }
+    if (cam.z_mm.empty()) throw runtime_error(fmt::format("camera '{}': no depth was measured", cam.id));
+    t.cameras.push_back(std::move(cam));
+  }
+  t.validate();
+  return t;
+}
+
+void write_text_file(const std::string& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+  if (!out) throw runtime_error(fmt::format("writing '{}' failed (is the disk full?)", path));
+}
+
+// The depth of each set: --z, else the session truth's planes[].z_mm.
+std::vector<double> set_depths(const PsfArgs& a, const storage::SessionReader& reader) {
+  std::vector<double> z;
   if (!a.z.empty()) {
     for (const std::string& t : split(a.z, ',')) z.push_back(number(t, "--z"));
   } else if (reader.has_truth()) {
@@ -273,9 +319,56 @@ void run_psf(const PsfArgs& a) {
       for (const auto& plane : p["planes"])
         if (plane.contains("z_mm")) z.push_back(plane["z_mm"].get<double>());
   }
-  if (z.size() != sets)
-    throw bad_input(fmt::format("--z: give one depth (mm) per set of '{}' ({} sets, {} depths given)", a.session, sets,
-                                z.size()));
+  if (z.size() != reader.set_count())
+    throw bad_input(fmt::format("--z: give one depth (mm) per set of '{}' ({} sets, {} depths given)", a.session,
+                                reader.set_count(), z.size()));
+  return z;
+}
+
+// Thesis Sect. 6.4: each image back-projected onto the voxel plane of its depth and measured.
+std::vector<PsfColumn> measure_in_voxel_planes(const PsfArgs& a, const storage::SessionReader& reader,
+                                               const std::vector<double>& z, optics::VoxelPlane& plane) {
+  const pipeline::SessionDescription description = pipeline::describe_session(reader);
+  const pipeline::SessionCameras cameras = pipeline::session_cameras(description, a.calib);
+  for (const std::string& w : cameras.warnings) fmt::print(stderr, "warning: {}\n", w);
+  const std::vector<const calibration::CameraModel*> models = cameras.pointers();
+  if (!a.grid.empty()) {
+    const VoxelGrid g = pipeline::parse_grid(a.grid);
+    plane = {g.origin.x, g.origin.y, 0.0, g.voxel_size, g.nx, g.ny};
+  } else {
+    std::vector<optics::ImageSize> sizes;
+    for (const storage::SessionCamera& c : reader.info().cameras) sizes.push_back({c.width, c.height});
+    plane = optics::common_view_plane(models, sizes, z);
+  }
+  plane.validate();
+  const optics::SpreadAxis axis = a.axis == "x" ? optics::SpreadAxis::x : optics::SpreadAxis::y;
+  std::vector<PsfColumn> cols(models.size(), PsfColumn(z.size()));
+  for (std::size_t k = 0; k < z.size(); ++k) {
+    const FrameSet set = reader.read_set(k);
+    for (std::size_t c = 0; c < models.size() && c < set.cameras.size(); ++c) {
+      if (!set.cameras[c].a.present()) continue;
+      optics::VoxelPlane at = plane;
+      at.z_mm = z[k];
+      try {
+        const optics::VoxelPsf psf = optics::measure_voxel_psf(set.cameras[c].a.image, *models[c], at, axis);
+        cols[c].chi_um[k] = psf.chi_um;
+        cols[c].chi_voxel_um[k] = psf.chi_voxel_um;
+        cols[c].sigma_px[k] = psf.sigma_px();
+        cols[c].object_pixel_um[k] = psf.object_pixel_um;
+        cols[c].edges[k] = psf.edges;
+      } catch (const Error& e) {
+        if (e.kind() != ErrorKind::bad_input) throw;
+        fmt::print(stderr, "set {} ({} mm), camera '{}': {}\n", k, z[k], reader.info().cameras[c].id, e.what());
+      }
+    }
+  }
+  return cols;
+}
+
+// The in-image variant: slanted edges measured in the camera image itself (no interpolation).
+std::vector<PsfColumn> measure_in_images(const PsfArgs& a, const storage::SessionReader& reader, const std::vector<double>& z) {
+  const std::size_t cams = reader.info().cameras.size();
+  std::vector<double> m;
   if (!a.magnification.empty()) {
     for (const std::string& t : split(a.magnification, ',')) m.push_back(number(t, "--magnification"));
     if (m.size() == 1) m.assign(cams, m[0]);
@@ -285,47 +378,120 @@ void run_psf(const PsfArgs& a) {
   } else if (!reader.has_truth() || reader.truth().cameras.size() != cams) {
     throw bad_input("--magnification is required: the session has no camera truth to convert pixels to um");
   }
-  // chi[c][k]
-  std::vector<std::vector<double>> chi(cams, std::vector<double>(sets, std::nan("")));
-  std::vector<std::vector<int>> edges(cams, std::vector<int>(sets, 0));
-  for (std::size_t k = 0; k < sets; ++k) {
+  optics::EdgeSpreadOptions options;
+  options.end_margin_rows = 12;  // a chessboard's edges end at corners
+  std::vector<PsfColumn> cols(cams, PsfColumn(z.size()));
+  for (std::size_t k = 0; k < z.size(); ++k) {
     const FrameSet set = reader.read_set(k);
     for (std::size_t c = 0; c < cams && c < set.cameras.size(); ++c) {
       if (!set.cameras[c].a.present()) continue;
       try {
-        const optics::EdgePsf psf = optics::measure_edge_psf(set.cameras[c].a.image);
-        chi[c][k] = psf.chi_px * object_pixel_um(reader, m, c, z[k]);
-        edges[c][k] = static_cast<int>(psf.edges.size());
+        const optics::EdgePsf psf = optics::measure_edge_psf(set.cameras[c].a.image, options);
+        const double pixel = object_pixel_um(reader, m, c, z[k]);
+        cols[c].chi_um[k] = psf.chi_px * pixel;
+        cols[c].sigma_px[k] = std::sqrt(std::max(0.25 * psf.chi_px * psf.chi_px - 1.0 / 12.0, 1e-6));
+        cols[c].object_pixel_um[k] = pixel;
+        cols[c].edges[k] = static_cast<int>(psf.edges.size());
       } catch (const Error& e) {
+        if (e.kind() != ErrorKind::bad_input) throw;
         fmt::print(stderr, "set {} ({} mm), camera '{}': {}\n", k, z[k], reader.info().cameras[c].id, e.what());
       }
     }
   }
+  return cols;
+}
+
+void run_psf(const PsfArgs& a) {
+  const bool voxel = a.method == "voxel";
+  if (!voxel && a.method != "image") throw bad_input(fmt::format("--method '{}': use voxel or image", a.method));
+  if (a.axis != "x" && a.axis != "y") throw bad_input(fmt::format("--axis '{}': use x or y", a.axis));
+  if (!voxel && (!a.psf_out.empty() || !a.png.empty() || !a.grid.empty() || !a.calib.empty()))
+    throw bad_input("--psf-out, --png, --grid and --calib belong to --method voxel (the back-projected planes)");
+  if (voxel && !a.magnification.empty())
+    throw bad_input("--magnification belongs to --method image: in voxel planes the cameras (--calib) give the scale");
   if (!a.setup_out.empty()) {
-    const std::string text = setup_toml(a, reader, m, z, chi);
-    optics::parse_optics_setup(text, a.setup_out);  // what we write must read back
-    std::ofstream out(a.setup_out);
-    out << text;
-    if (!out) throw runtime_error(fmt::format("writing '{}' failed (is the disk full?)", a.setup_out));
+    storage::check_output_path(a.setup_out, a.overwrite, "set-up");
+    if (!(a.f_number > 0) || a.noise.empty())
+      throw bad_input("--setup-out needs --f-number and --noise (sigma of the flat-fielded bright field, one or one "
+                      "per camera) to describe the cameras");
   }
+  if (!a.psf_out.empty()) storage::check_output_path(a.psf_out, a.overwrite, "PSF file");
+  if (!a.png.empty()) storage::check_output_path(a.png, a.overwrite, "plot");
+  cli::require_session(a.session, "optics psf");
+  const storage::SessionReader reader(a.session);
+  const std::size_t sets = reader.set_count(), cams = reader.info().cameras.size();
+  if (sets == 0) throw bad_input(fmt::format("session '{}' has no sets: record one target image per depth", a.session));
+  const std::vector<double> z = set_depths(a, reader);
+  optics::VoxelPlane plane;
+  const std::vector<PsfColumn> cols = voxel ? measure_in_voxel_planes(a, reader, z, plane) : measure_in_images(a, reader, z);
+  if (std::none_of(cols.begin(), cols.end(), [](const PsfColumn& c) {
+        return std::any_of(c.chi_um.begin(), c.chi_um.end(), [](double v) { return std::isfinite(v); });
+      }))
+    throw bad_input(fmt::format("no image of '{}' gave a PSF (the reasons are above): are they chessboard images, and is "
+                                "the plane where the board is?",
+                                a.session));
+
+  // Everything is checked before anything is written.
+  std::string setup_text, psf_text;
+  std::optional<optics::PsfTable> table;
+  if (!a.setup_out.empty()) {
+    setup_text = setup_toml(a, reader, z, cols);
+    optics::parse_optics_setup(setup_text, a.setup_out);  // what we write must read back
+  }
+  if (voxel && (!a.psf_out.empty() || !a.png.empty())) table = psf_table(reader, plane, a.axis, z, cols);
+  if (!a.psf_out.empty()) {
+    psf_text = optics::psf_table_toml(*table, fmt::format("PSF per camera and depth, measured by `tomorig optics psf` on {}\n"
+                                                          "from chessboard edges in voxel planes (docs/spray.md).",
+                                                          a.session));
+    optics::parse_psf_table(psf_text, a.psf_out);
+  }
+  if (!a.setup_out.empty()) write_text_file(a.setup_out, setup_text);
+  if (!a.psf_out.empty()) write_text_file(a.psf_out, psf_text);
+  if (!a.png.empty()) storage::write_png(a.png, optics::psf_plot(*table));
+
   if (a.json.wanted()) {
     nlohmann::json out = nlohmann::json::array();
     for (std::size_t c = 0; c < cams; ++c) {
-      nlohmann::json values = nlohmann::json::array();
-      for (double v : chi[c]) values.push_back(finite_or_null(v));
-      out.push_back({{"id", reader.info().cameras[c].id}, {"z_mm", z}, {"chi_um", values}, {"edges", edges[c]}});
+      nlohmann::json chi = nlohmann::json::array(), chi_voxel = nlohmann::json::array(), sigma = nlohmann::json::array();
+      for (std::size_t k = 0; k < sets; ++k) {
+        chi.push_back(finite_or_null(cols[c].chi_um[k]));
+        chi_voxel.push_back(finite_or_null(cols[c].chi_voxel_um[k]));
+        sigma.push_back(finite_or_null(cols[c].sigma_px[k]));
+      }
+      nlohmann::json cam = {{"id", reader.info().cameras[c].id}, {"z_mm", z},      {"chi_um", chi},
+                            {"sigma_px", sigma},                 {"edges", cols[c].edges}};
+      if (voxel) cam["chi_voxel_um"] = chi_voxel;
+      out.push_back(cam);
     }
-    emit_json(a.json, with_command("optics psf", nlohmann::json{{"session", a.session}, {"cameras", out}}));
+    nlohmann::json j{{"session", a.session}, {"method", a.method}, {"cameras", out}};
+    if (voxel)
+      j["plane"] = {{"x0_mm", plane.x0_mm}, {"y0_mm", plane.y0_mm}, {"voxel_mm", plane.voxel_mm},
+                    {"nx", plane.nx},       {"ny", plane.ny},       {"axis", a.axis}};
+    if (!a.psf_out.empty()) j["psf_out"] = a.psf_out;
+    if (!a.png.empty()) j["png"] = a.png;
+    if (!a.setup_out.empty()) j["setup_out"] = a.setup_out;
+    emit_json(a.json, with_command("optics psf", j));
     if (a.json.to_stdout()) return;
   }
-  fmt::print("PSF half-width chi [um] from edges (knife-edge, Gaussian fit of the line spread)\n{:>8}", "z [mm]");
-  for (std::size_t c = 0; c < cams; ++c) fmt::print(" {:>8}", reader.info().cameras[c].id);
+  if (voxel)
+    fmt::print("PSF half-width chi [um] from chessboard edges back-projected onto voxel planes ({} x {} voxels of {:.4f} "
+               "mm, spread along {}): the camera's PSF (in the voxel plane)\n",
+               plane.nx, plane.ny, plane.voxel_mm, a.axis);
+  else
+    fmt::print("PSF half-width chi [um] from edges in the camera images (knife-edge, Gaussian fit of the line spread)\n");
+  fmt::print("{:>8}", "z [mm]");
+  for (std::size_t c = 0; c < cams; ++c) fmt::print(" {:>16}", reader.info().cameras[c].id);
   fmt::print("\n");
   for (std::size_t k = 0; k < sets; ++k) {
     fmt::print("{:>8.2f}", z[k]);
-    for (std::size_t c = 0; c < cams; ++c) fmt::print(" {:>8}", cell(chi[c][k]));
+    for (std::size_t c = 0; c < cams; ++c)
+      fmt::print(" {:>16}", voxel && std::isfinite(cols[c].chi_um[k])
+                                ? fmt::format("{} ({})", cell(cols[c].chi_um[k]), cell(cols[c].chi_voxel_um[k]))
+                                : cell(cols[c].chi_um[k]));
     fmt::print("\n");
   }
+  for (const std::string* f : {&a.psf_out, &a.setup_out, &a.png})
+    if (!f->empty()) fmt::print("wrote {}\n", *f);
 }
 
 void add_common(CLI::App* cmd, OpticsArgs& a) {
@@ -363,19 +529,29 @@ void add_optics_command(CLI::App& root) {
   t->callback([tr] { run_transmission(*tr); });
 
   auto psf = std::make_shared<PsfArgs>();
-  CLI::App* p = optics_cmd->add_subcommand("psf", "PSF half-width chi per camera and depth from edge-target images "
-                                                  "(knife-edge technique, Sect. 6.4)");
+  CLI::App* p = optics_cmd->add_subcommand("psf", "PSF half-width chi per camera and depth from chessboard calibration "
+                                                  "images (knife-edge technique in voxel planes, Sect. 6.4)");
   cli::add_session_argument(*p, psf->session, "session with one set per depth, each camera's target image in exposure A");
   p->add_option("--z", psf->z, "depth of each set in mm, comma-separated (default: the session truth's planes)");
+  p->add_option("--method", psf->method, "voxel: back-project onto voxel planes (thesis); image: edges in the camera "
+                                         "images")
+      ->capture_default_str();
+  p->add_option("--calib", psf->calib, "cameras for the back-projection: a calibration file (tomorig calibrate) or "
+                                       "'truth' (default: the truth if present, else the rig config's calibration)");
+  p->add_option("--grid", psf->grid, "the voxel planes: nx,ny,nz,voxel_mm[,cx,cy,cz] (nz and cz unused; default: the "
+                                     "square every camera sees at every depth, ~1 voxel per pixel)");
+  p->add_option("--axis", psf->axis, "direction of the measured spread in the plane: x or y")->capture_default_str();
   p->add_option("--magnification", psf->magnification,
-                "magnification, one or one per camera (default: from the session's truth cameras)");
+                "--method image: magnification, one or one per camera (default: from the session's truth cameras)");
   add_json_flag(*p, psf->json);
+  p->add_option("--png", psf->png, "write the plot of chi over depth (Fig. 6.15 / 7.9 style) to this PNG");
+  p->add_option("--psf-out", psf->psf_out, "write the PSF file (TOML) that `reconstruct --psf` / `process --psf` read");
   p->add_option("--setup-out", psf->setup_out, "also write the result as an optics set-up file (TOML) for "
                                                "`optics visibility --setup`");
   p->add_option("--f-number", psf->f_number, "--setup-out: the lenses' f-number");
   p->add_option("--noise", psf->noise, "--setup-out: sigma of the flat-fielded bright field, one or one per camera");
   p->add_option("--liquid", psf->liquid, "--setup-out: water or kerosene")->capture_default_str();
-  p->add_flag("--overwrite", psf->overwrite, "replace an existing --setup-out file");
+  p->add_flag("--overwrite", psf->overwrite, "replace existing --setup-out, --psf-out or --png files");
   p->callback([psf] { run_psf(*psf); });
 }
 

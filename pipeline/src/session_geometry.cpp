@@ -12,6 +12,7 @@
 #include "tomorig/core/error.h"
 #include "tomorig/processing/calibration/calibration_file.h"
 #include "tomorig/processing/calibration/pinhole_camera.h"
+#include "tomorig/processing/optics/psf_table.h"
 
 namespace tomorig::pipeline {
 namespace {
@@ -186,7 +187,36 @@ void add_reconstruction_flags(CLI::App& cmd, ReconstructionChoices& choices, con
   cmd.add_option("--sigma-px", choices.sigma_px,
                  "Gaussian sigma of the voxel-to-pixel weights (PSF), pixels, all cameras")
       ->capture_default_str();
+  cmd.add_option("--psf", choices.psf_file,
+                 "PSF file from `tomorig optics psf --psf-out`: each camera's measured sigma over depth (instead of "
+                 "--sigma-px)");
 }
+
+namespace {
+
+// Each session camera's depth-varying PSF from a PSF file, matched by camera id.
+std::vector<recon::PsfModel> measured_psf(const SessionDescription& session, const std::string& file) {
+  const optics::PsfTable table = optics::read_psf_table(file);
+  std::vector<recon::PsfModel> out;
+  for (const storage::SessionCamera& c : session.cameras) {
+    const optics::PsfTableCamera* cam = table.find(c.id);
+    if (cam == nullptr) {
+      std::string ids;
+      for (const optics::PsfTableCamera& t : table.cameras) ids += (ids.empty() ? "" : ", ") + t.id;
+      throw bad_input(fmt::format("--psf {}: no PSF for camera '{}' of {} (the file has {}): measure it with `tomorig "
+                                  "optics psf` on this rig's calibration images",
+                                  file, c.id, session.name, ids));
+    }
+    recon::PsfModel model;
+    for (std::size_t k = 0; k < cam->z_mm.size(); ++k)
+      model.samples.push_back({cam->z_mm[k], cam->sigma_px[k], cam->sigma_px[k]});
+    model.validate(fmt::format("--psf {}: camera '{}'", file, c.id));
+    out.push_back(std::move(model));
+  }
+  return out;
+}
+
+}  // namespace
 
 ReconstructionSetup reconstruction_setup(const SessionDescription& session, const SessionCameras& cameras,
                                          const ReconstructionChoices& choices) {
@@ -210,6 +240,7 @@ ReconstructionSetup reconstruction_setup(const SessionDescription& session, cons
   input.psf.assign(input.cameras.size(), recon::PsfModel::constant(choices.sigma_px));
   for (const storage::SessionCamera& c : session.cameras) input.sensor_sizes.push_back({c.width, c.height});
   if (!input.psf.empty()) input.psf.front().validate("--sigma-px");
+  if (!choices.psf_file.empty()) input.psf = measured_psf(session, choices.psf_file);
   return setup;
 }
 

@@ -108,14 +108,14 @@ std::string write_spray_target_session(const sim::SprayOptions& options, const s
   const std::vector<optics::ChiSample>& depths = c.cameras.front().chi;
   nlohmann::json planes = nlohmann::json::array();
   for (std::size_t k = 0; k < depths.size(); ++k) planes.push_back({{"set", k}, {"z_mm", depths[k].z_mm}});
-  const nlohmann::json parameters = {{"target", "bars: 1 mm clear, 1 mm chromium (5 %), slanted 4 deg from y"},
+  const nlohmann::json parameters = {{"target", "chessboard: 2 mm squares, clear and chromium (5 %), turned 3 deg"},
                                      {"planes", planes},
                                      {"reduced", c.options.reduced},
                                      {"cameras", spray_cameras_json(c)},
                                      {"optics_setup_toml", spray_optics_setup_toml(c)}};
   storage::SessionWriter writer = open_spray_writer(
       out, c, compression, overwrite,
-      "# Written by `tomorig simulate --case spray-thesis --targets`: set k shows a slanted bar photomask at\n"
+      "# Written by `tomorig simulate --case spray-thesis --targets`: set k shows a chessboard photomask at\n"
       "# depth k (planes[k].z_mm in /truth flow_parameters), for `tomorig optics psf`. No rig config applies.\n");
   writer.write_truth(spray_truth(c, "traverse", parameters));
   for (std::size_t k = 0; k < depths.size(); ++k) {
@@ -125,7 +125,7 @@ std::string write_spray_target_session(const sim::SprayOptions& options, const s
     for (std::size_t ci = 0; ci < c.cameras.size(); ++ci) {
       CameraFrames frames;
       frames.camera_id = c.cameras[ci].id;
-      frames.a.image = sim::render_spray_edge_target(c, ci, depths[k].z_mm, k);
+      frames.a.image = sim::render_spray_chessboard_target(c, ci, depths[k].z_mm, k);
       set.cameras.push_back(std::move(frames));
     }
     writer.append(set);

@@ -285,4 +285,82 @@ Image render_spray_edge_target(const SprayCase& c, std::size_t camera, double z_
   return digitise_camera(c, camera, signal, derive_seed(c.options.seed, {kBrightStream, frame, camera, 11}));
 }
 
+Image render_spray_chessboard_target(const SprayCase& c, std::size_t camera, double z_mm, std::uint64_t frame,
+                                     double square_mm, double rotation_deg) {
+  if (!(square_mm > 0) || !(std::abs(rotation_deg) < 45))
+    throw bad_input(fmt::format("spray chessboard: square {} mm must be > 0 and the turn {} deg within +-45", square_mm,
+                                rotation_deg));
+  const SprayCamera& cam = c.cameras.at(camera);
+  const double level = c.options.bright_fraction * 65535.0;
+  const double energy = pulse_energy(c, kBrightStream, frame + 2000003, camera, 1);
+  constexpr double kChromium = 0.05;
+  const double cs = std::cos(rotation_deg * M_PI / 180.0), sn = std::sin(rotation_deg * M_PI / 180.0);
+  // The image-space PSF at this depth, as a droplet there gets it (project() above).
+  const Vec3d centre{0.0, 0.0, z_mm};
+  const double object_pixel_um = cam.pixel_pitch_um / cam.pinhole.magnification(centre, cam.pixel_pitch_um);
+  const double chi_px = spray_chi_um(cam, z_mm) / object_pixel_um;
+  const double sigma_px = std::sqrt(std::max(0.25 * chi_px * chi_px - 1.0 / 12.0, 1e-4));
+  const double k = 1.0 / (std::sqrt(2.0) * sigma_px);
+  const int w = cam.width, h = cam.height;
+  // Board coordinates (s, t) in mm at every pixel centre (one extra row and column for the
+  // gradients); NaN where the line of sight misses the plane.
+  std::vector<double> s_at(static_cast<std::size_t>(w + 1) * (h + 1)), t_at(s_at.size());
+  for (int y = 0; y <= h; ++y)
+    for (int x = 0; x <= w; ++x) {
+      const Vec3d p = cam.pinhole.back_project({double(x), double(y)}, z_mm);
+      const std::size_t i = static_cast<std::size_t>(y) * (w + 1) + x;
+      s_at[i] = p.x * cs + p.y * sn;
+      t_at[i] = -p.x * sn + p.y * cs;
+    }
+  // Signed distance (mm) to the nearest line of a square wave of period 2 * square: > 0 inside
+  // the squares counted as +1.
+  const auto signed_distance = [square_mm](double s) {
+    const double period = 2.0 * square_mm;
+    const double q = s - period * std::floor(s / period);
+    return q < square_mm ? std::min(q, square_mm - q) : -std::min(q - square_mm, period - q);
+  };
+  Image signal = Image::allocate(w, h, SampleType::f32);
+  constexpr int kSub = 4;  // 4 x 4 samples over each pixel's area
+#pragma omp parallel for num_threads(detail::thread_count(c.options.threads)) schedule(static)
+  for (int y = 0; y < h; ++y) {
+    float* row = signal.row<float>(y);
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * (w + 1) + x;
+      const double s0 = s_at[i], t0 = t_at[i];
+      double mask = 1.0;
+      if (std::isfinite(s0) && std::isfinite(t0)) {
+        // s and t are linear over a pixel; their gradients (mm per pixel) turn plane distances
+        // into image pixels, where the PSF lives.
+        const double su = s_at[i + 1] - s0, sv = s_at[i + w + 1] - s0;
+        const double tu = t_at[i + 1] - t0, tv = t_at[i + w + 1] - t0;
+        const double s_mm_per_px = std::hypot(su, sv), t_mm_per_px = std::hypot(tu, tv);
+        // Far from every line (the pixel's reach plus 6 sigma: erf = 1 to 1e-8) the board is
+        // its plain colour; only the pixels near a line need the blurred sub-samples.
+        const double ds = signed_distance(s0), dt = signed_distance(t0);
+        const double reach_s = 0.5 * (std::abs(su) + std::abs(sv)) + 6.0 * sigma_px * s_mm_per_px;
+        const double reach_t = 0.5 * (std::abs(tu) + std::abs(tv)) + 6.0 * sigma_px * t_mm_per_px;
+        if (std::abs(ds) > reach_s && std::abs(dt) > reach_t) {
+          mask = (ds > 0) == (dt > 0) ? 1.0 : kChromium;
+          row[x] = static_cast<float>(energy * bright_field(cam, level, c.options.vignetting, x, y) * mask);
+          continue;
+        }
+        double sum = 0.0;
+        for (int j = 0; j < kSub; ++j)
+          for (int q = 0; q < kSub; ++q) {
+            const double fu = (q + 0.5) / kSub - 0.5, fv = (j + 0.5) / kSub - 0.5;
+            const double s = s0 + fu * su + fv * sv, t = t0 + fu * tu + fv * tv;
+            // Each board line blurred on its own ((2 Phi - 1) of the distance in pixels / sigma),
+            // the board their product (exact away from the corners); 1 on the clear squares.
+            const double bs = std::erf(signed_distance(s) / s_mm_per_px * k);
+            const double bt = std::erf(signed_distance(t) / t_mm_per_px * k);
+            sum += 0.5 * (1.0 + bs * bt);
+          }
+        mask = kChromium + (1.0 - kChromium) * sum / (kSub * kSub);
+      }
+      row[x] = static_cast<float>(energy * bright_field(cam, level, c.options.vignetting, x, y) * mask);
+    }
+  }
+  return digitise_camera(c, camera, signal, derive_seed(c.options.seed, {kBrightStream, frame, camera, 13}));
+}
+
 }  // namespace tomorig::sim

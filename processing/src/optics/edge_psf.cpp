@@ -33,6 +33,12 @@ bool solve4(std::array<std::array<double, 4>, 4> a, std::array<double, 4>& b) {
   return true;
 }
 
+// chi of the edge spread binned in sum / count (bins of o.bin_px from -o.half_width_px): its
+// central differences fitted with a Gaussian, the differencing's own box removed. NaN if
+// fewer than 5 line-spread samples.
+double chi_from_edge_spread(const std::vector<double>& sum, const std::vector<double>& count,
+                            const EdgeSpreadOptions& o, double* rms_residual);
+
 struct Crossing {
   double u;
   int row;
@@ -90,6 +96,31 @@ double fit_line_spread_chi(const std::vector<double>& x, const std::vector<doubl
   return std::abs(p[2]);
 }
 
+namespace {
+
+double chi_from_edge_spread(const std::vector<double>& sum, const std::vector<double>& count,
+                            const EdgeSpreadOptions& o, double* rms_residual) {
+  std::vector<double> esf_x, esf;
+  for (std::size_t i = 0; i < sum.size(); ++i)
+    if (count[i] > 0) {
+      esf_x.push_back(-o.half_width_px + (static_cast<double>(i) + 0.5) * o.bin_px);
+      esf.push_back(sum[i] / count[i]);
+    }
+  // Line spread: the derivative by central differences.
+  std::vector<double> lsf_x, lsf;
+  for (std::size_t i = 1; i + 1 < esf.size(); ++i) {
+    lsf_x.push_back(esf_x[i]);
+    lsf.push_back((esf[i + 1] - esf[i - 1]) / (esf_x[i + 1] - esf_x[i - 1]));
+  }
+  if (lsf.size() < 5) return std::nan("");
+  const double chi = fit_line_spread_chi(lsf_x, lsf, rms_residual);
+  // Differencing over +-1 bin widens the line spread by a box of 2 bins: remove its variance.
+  const double sigma2 = 0.25 * chi * chi - (2.0 * o.bin_px) * (2.0 * o.bin_px) / 12.0;
+  return 2.0 * std::sqrt(std::max(sigma2, 1e-6));
+}
+
+}  // namespace
+
 EdgePsf measure_edge_psf(const Image& image, const EdgeSpreadOptions& o) {
   const int w = image.width(), h = image.height();
   if (image.empty() || w < 4 * o.half_width_px || h < o.min_rows)
@@ -112,6 +143,7 @@ EdgePsf measure_edge_psf(const Image& image, const EdgeSpreadOptions& o) {
   }
   // Group crossings into edges: seeded in the middle rows, followed row by row.
   EdgePsf out;
+  std::vector<double> pooled_sum, pooled_count;
   std::vector<bool> used(crossings.size(), false);
   for (std::size_t seed = 0; seed < crossings.size(); ++seed) {
     if (used[seed]) continue;
@@ -128,6 +160,11 @@ EdgePsf measure_edge_psf(const Image& image, const EdgeSpreadOptions& o) {
         last_u = crossings[k].u;
         last_row = crossings[k].row;
       }
+    }
+    if (o.end_margin_rows > 0) {
+      const int first = crossings[members.front()].row + o.end_margin_rows;
+      const int last = crossings[members.back()].row - o.end_margin_rows;
+      std::erase_if(members, [&](std::size_t m) { return crossings[m].row < first || crossings[m].row > last; });
     }
     if (static_cast<int>(members.size()) < o.min_rows) continue;
     // The edge line u = a + b v by least squares.
@@ -159,33 +196,30 @@ EdgePsf measure_edge_psf(const Image& image, const EdgeSpreadOptions& o) {
         count[bin] += 1.0;
       }
     }
-    std::vector<double> esf_x, esf;
-    for (int i = 0; i < bins; ++i)
-      if (count[i] > 0) {
-        esf_x.push_back(-o.half_width_px + (i + 0.5) * o.bin_px);
-        esf.push_back(sum[i] / count[i]);
-      }
-    // Line spread: the derivative by central differences.
-    std::vector<double> lsf_x, lsf;
-    for (std::size_t i = 1; i + 1 < esf.size(); ++i) {
-      lsf_x.push_back(esf_x[i]);
-      lsf.push_back((esf[i + 1] - esf[i - 1]) / (esf_x[i + 1] - esf_x[i - 1]));
-    }
-    if (lsf.size() < 5) continue;
     EdgeMeasurement e;
     e.position_px = a + b * 0.5 * (h - 1);
     e.slope = b;
     e.rows = static_cast<int>(members.size());
-    e.chi_px = fit_line_spread_chi(lsf_x, lsf, &e.rms_residual);
-    // Differencing over +-1 bin widens the line spread by a box of 2 bins: remove its variance.
-    const double sigma2 = 0.25 * e.chi_px * e.chi_px - (2.0 * o.bin_px) * (2.0 * o.bin_px) / 12.0;
-    e.chi_px = 2.0 * std::sqrt(std::max(sigma2, 1e-6));
+    e.chi_px = chi_from_edge_spread(sum, count, o, &e.rms_residual);
+    if (!std::isfinite(e.chi_px)) continue;
     out.edges.push_back(e);
+    if (o.pool_edges) {
+      pooled_sum.resize(sum.size(), 0.0);
+      pooled_count.resize(count.size(), 0.0);
+      for (std::size_t i = 0; i < sum.size(); ++i) {
+        pooled_sum[i] += sum[i];
+        pooled_count[i] += count[i];
+      }
+    }
   }
   if (out.edges.empty())
     throw bad_input(fmt::format("edge PSF: no measurable edge in the {} x {} px image (edges must be within 30 deg of "
                                 "vertical, cross >= {} rows and have a contrast >= {})",
                                 w, h, o.min_rows, o.min_contrast));
+  if (o.pool_edges) {
+    out.chi_px = chi_from_edge_spread(pooled_sum, pooled_count, o, &out.rms_residual);
+    return out;
+  }
   std::vector<double> chis;
   for (const EdgeMeasurement& e : out.edges) chis.push_back(e.chi_px);
   std::sort(chis.begin(), chis.end());

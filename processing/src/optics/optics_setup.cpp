@@ -8,65 +8,13 @@
 
 #include <fmt/core.h>
 
+#include "optics/toml_reader.h"
 #include "tomorig/config/toml_document.h"
 #include "tomorig/core/error.h"
 
 namespace tomorig::optics {
-namespace {
 
-class Reader {
- public:
-  Reader(const std::string& source, std::string path, config::TomlNode table)
-      : source_(source), path_(std::move(path)), table_(table) {}
-
-  [[noreturn]] void fail(const std::string& key, config::TomlNode node, const std::string& problem) const {
-    const int line = node ? node.line() : table_.line();
-    const std::string where = path_.empty() ? key : (key.empty() ? path_ : path_ + "." + key);
-    throw bad_input(fmt::format("{}: {} (line {}): {}", source_, where, line, problem));
-  }
-  void only(const std::set<std::string>& allowed) const {
-    for (const auto& [key, value] : table_.entries()) {
-      if (allowed.count(key)) continue;
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      fail(key, value, "is not a key here; allowed: " + list);
-    }
-  }
-  bool has(const char* key) const { return table_.contains(key); }
-  double number(const char* key) const {
-    const config::TomlNode n = table_[key];
-    if (!n) fail(key, {}, "is required");
-    return as_number(key, n);
-  }
-  double as_number(const std::string& key, config::TomlNode n) const {
-    if (!n.is_number()) fail(key, n, "must be a number");
-    const double v = n.is_integer() ? static_cast<double>(*n.as_integer()) : *n.as_double();
-    if (!std::isfinite(v)) fail(key, n, "must be a finite number");
-    return v;
-  }
-  std::string string(const char* key) const {
-    const config::TomlNode n = table_[key];
-    if (!n) fail(key, {}, "is required");
-    if (!n.is_string()) fail(key, n, "must be a string");
-    return *n.as_string();
-  }
-  std::vector<double> numbers(const char* key) const {
-    const config::TomlNode n = table_[key];
-    if (!n) fail(key, {}, "is required");
-    if (!n.is_array() || n.size() == 0) fail(key, n, "must be a non-empty array of numbers");
-    std::vector<double> out;
-    for (std::size_t i = 0; i < n.size(); ++i) out.push_back(as_number(fmt::format("{}[{}]", key, i), n[i]));
-    return out;
-  }
-  config::TomlNode node(const char* key) const { return table_[key]; }
-
- private:
-  const std::string& source_;
-  std::string path_;
-  config::TomlNode table_;
-};
-
-}  // namespace
+using TomlReader = detail::TomlReader;
 
 VisibilitySetup parse_optics_setup(std::string_view toml_text, const std::string& source) {
   std::optional<config::TomlDocument> doc;
@@ -76,7 +24,7 @@ VisibilitySetup parse_optics_setup(std::string_view toml_text, const std::string
     throw bad_input(fmt::format("{}: line {}: {}", source, e.line(), e.description()));
   }
   VisibilitySetup setup;
-  const Reader top(source, "", doc->root());
+  const TomlReader top(source, "", doc->root());
   top.only({"liquid", "led", "cameras", "d_max_um"});
   if (top.has("liquid")) {
     try {
@@ -88,7 +36,7 @@ VisibilitySetup parse_optics_setup(std::string_view toml_text, const std::string
   if (top.has("d_max_um")) setup.d_max_um = top.number("d_max_um");
   if (const config::TomlNode led = top.node("led")) {
     if (!led.is_table()) top.fail("led", led, "must be a table ([led])");
-    const Reader r(source, "led", led);
+    const TomlReader r(source, "led", led);
     r.only({"peak_nm", "fwhm_nm", "samples"});
     if (r.has("peak_nm")) setup.spectrum.peak_nm = r.number("peak_nm");
     if (r.has("fwhm_nm")) setup.spectrum.fwhm_nm = r.number("fwhm_nm");
@@ -105,7 +53,7 @@ VisibilitySetup parse_optics_setup(std::string_view toml_text, const std::string
                                 "threshold), z_mm and chi_um",
                                 source));
   for (std::size_t i = 0; i < cams.size(); ++i) {
-    const Reader r(source, fmt::format("cameras[{}]", i), cams[i]);
+    const TomlReader r(source, fmt::format("cameras[{}]", i), cams[i]);
     r.only({"id", "f_number", "magnification", "noise", "threshold", "z_mm", "chi_um"});
     CameraOptics c;
     c.id = r.has("id") ? r.string("id") : fmt::format("camera {}", i + 1);

@@ -114,6 +114,15 @@ Image render_bright_field(const SprayCase& c, std::size_t camera, std::uint64_t 
 // and noise of frame `frame`.
 Image render_spray_edge_target(const SprayCase& c, std::size_t camera, double z_mm, std::uint64_t frame,
                                double slant_deg = 4.0);
+// A chessboard calibration image for the knife-edge PSF in voxel space (Sect. 6.4, 7.3.3): a
+// back-lit photomask chessboard of `square_mm` squares (clear / chromium at 5 % transmission)
+// filling the view on the plane z = z_mm, its lines turned by
+// `rotation_deg` from the world x and y axes (a real board is never aligned exactly; the turn
+// lets the edges sample every sub-voxel phase), a square corner at the origin; seen through
+// camera c's PSF at that depth (the blur and pixel integration the droplets get), with the
+// bright field and noise of frame `frame`.
+Image render_spray_chessboard_target(const SprayCase& c, std::size_t camera, double z_mm, std::uint64_t frame,
+                                     double square_mm = 2.0, double rotation_deg = 3.0);
 // The PSF half-width of camera c at world depth z (object um), linearly interpolated in the
 // truth samples (clamped at the ends).
 double spray_chi_um(const SprayCamera& cam, double z_mm);

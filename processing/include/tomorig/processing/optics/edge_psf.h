@@ -19,6 +19,13 @@ struct EdgeSpreadOptions {
   double bin_px = 0.25;      // edge-spread bin across the edge
   double min_contrast = 0.2;  // (light - dark) / light of a row for its edges to count
   int min_rows = 20;         // rows an edge must cross to be measured
+  // Rows dropped at both ends of each edge before it is measured: a chessboard's edges end at
+  // corners, where the crossing edge would widen the spread (0: keep every row, for bars).
+  int end_margin_rows = 0;
+  // chi from the mean edge spread of all edges (each centred on its own line) instead of the
+  // median of the edges' own fits: for flat-fielded images, whose edges share one level, and
+  // short edges (a chessboard's), whose sub-pixel phases the pooled spread covers better.
+  bool pool_edges = false;
 };
 
 struct EdgeMeasurement {
@@ -31,7 +38,8 @@ struct EdgeMeasurement {
 
 struct EdgePsf {
   std::vector<EdgeMeasurement> edges;
-  double chi_px = 0;  // median over the edges
+  double chi_px = 0;  // median over the edges, or the pooled spread's (pool_edges)
+  double rms_residual = 0;  // the pooled fit's (pool_edges), relative to its peak
 };
 
 // Throws bad_input if the image has no measurable edge (names the image size and contrast).
