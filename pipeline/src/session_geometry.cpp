@@ -12,6 +12,7 @@
 #include "tomorig/core/error.h"
 #include "tomorig/processing/calibration/calibration_file.h"
 #include "tomorig/processing/calibration/pinhole_camera.h"
+#include "tomorig/pipeline/spray_psf.h"
 
 namespace tomorig::pipeline {
 namespace {
@@ -186,6 +187,9 @@ void add_reconstruction_flags(CLI::App& cmd, ReconstructionChoices& choices, con
   cmd.add_option("--sigma-px", choices.sigma_px,
                  "Gaussian sigma of the voxel-to-pixel weights (PSF), pixels, all cameras")
       ->capture_default_str();
+  cmd.add_option("--psf", choices.psf,
+                 "Depth-varying PSF per camera instead of --sigma-px: an optics set-up file (chi(z) per camera, from "
+                 "'tomorig optics psf --setup-out') or 'truth' (a simulated spray session's); docs/spray.md");
 }
 
 ReconstructionSetup reconstruction_setup(const SessionDescription& session, const SessionCameras& cameras,
@@ -207,9 +211,14 @@ ReconstructionSetup reconstruction_setup(const SessionDescription& session, cons
   recon::ReconstructionInput& input = setup.input;
   input.cameras = cameras.pointers();
   input.grid = choices.grid.empty() ? grid_from_session(session) : parse_grid(choices.grid);
-  input.psf.assign(input.cameras.size(), recon::PsfModel::constant(choices.sigma_px));
+  if (choices.psf.empty()) {
+    input.psf.assign(input.cameras.size(), recon::PsfModel::constant(choices.sigma_px));
+    if (!input.psf.empty()) input.psf.front().validate("--sigma-px");
+  } else {
+    input.psf = psf_from_optics_setup(spray_optics_setup(choices.psf, session.truth), session.cameras, input.cameras,
+                                      input.grid);
+  }
   for (const storage::SessionCamera& c : session.cameras) input.sensor_sizes.push_back({c.width, c.height});
-  if (!input.psf.empty()) input.psf.front().validate("--sigma-px");
   return setup;
 }
 

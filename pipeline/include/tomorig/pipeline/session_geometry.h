@@ -91,9 +91,12 @@ struct ReconstructionChoices {
   int iterations = 0;  // named on the command line; 0: the rig config's, else options.max_iterations
   std::string grid;    // empty: the rig config's [grid]; else as parse_grid
   double sigma_px = recon::kDefaultPsfSigmaPx;  // weight (PSF) sigma of every camera, pixels
+  // Empty: sigma_px everywhere. Else "truth" or an optics set-up file: each camera's PSF over
+  // depth from its chi(z) (spray_psf.h), replacing sigma_px.
+  std::string psf;
 };
 
-// Registers --algorithm, --iterations, --relaxation, --mlos-threshold, --grid and --sigma-px,
+// Registers --algorithm, --iterations, --relaxation, --mlos-threshold, --grid, --sigma-px and --psf,
 // bound to `choices` (defaults shown from the library's options). `algorithm_default` says in
 // the help what an absent --algorithm means.
 void add_reconstruction_flags(CLI::App& cmd, ReconstructionChoices& choices, const std::string& algorithm_default);
