@@ -35,14 +35,17 @@ namespace {
 struct BenchSprayArgs {
   std::string session;
   std::string calib;
-  std::string chain = "shadow-b";
+  std::string chain = "shadow-detect";
   std::string results;
   std::string sets;
   std::vector<double> classes_um{5, 10, 15, 20, 30, 50, 100};
   int depth_bins = 5;
   double match_voxels = 3.0;
-  particles::DropletDetectionOptions detection;
-  pipeline::ReconstructionChoices recon{.algorithm_from_rig = false};
+  particles::DropletDetectionOptions detection{.relative_peak_threshold = 0.0};
+  // MENT, as the thesis reconstructed its sprays (Sect. 7.4): additive, so a faint droplet keeps
+  // an intensity in proportion to its shadows; FMART's products and pruning drop droplets near
+  // the visibility limit next to bright ones (docs/accuracy.md).
+  pipeline::ReconstructionChoices recon{.algorithm = "ment", .algorithm_from_rig = false};
   std::string json_out;
 };
 
@@ -350,12 +353,12 @@ void add_bench_spray_command(CLI::App& bench) {
                "predicted visibility limit, and (--results) velocity RMS per size class against the truth");
   cmd->add_option("session", args->session, "spray-thesis session (.h5) with truth")->required();
   cmd->add_option("--calib", args->calib, "Calibration file, or 'truth' (default: the truth)");
-  cmd->add_option("--chain", args->chain, "Preprocessing chain: a preset (shadow-a, shadow-b) or a chain TOML")
+  cmd->add_option("--chain", args->chain, "Preprocessing chain for the detection: a preset (shadow-detect, shadow-a, shadow-b) or a chain TOML")
       ->capture_default_str();
   cmd->add_option("--results", args->results,
                   "Results file of 'tomorig process' on the same session (with the same --chain, --psf and --grid): "
                   "droplet velocities from its 3-D correlation");
-  pipeline::add_reconstruction_flags(*cmd, args->recon, "fmart");
+  pipeline::add_reconstruction_flags(*cmd, args->recon, "ment");
   cmd->add_option("--sets", args->sets, "Sets to judge (N, A:B or a list); default all");
   cmd->add_option("--classes", args->classes_um, "Size-class edges, um (truth diameter)")
       ->delimiter(',')
@@ -364,7 +367,7 @@ void add_bench_spray_command(CLI::App& bench) {
   cmd->add_option("--match-voxels", args->match_voxels, "A blob matches a droplet within this distance, voxels")
       ->capture_default_str();
   cmd->add_option("--peak-threshold", args->detection.relative_peak_threshold,
-                  "A blob's peak must exceed this fraction of the volume's brightest voxel")
+                  "A blob's peak must exceed this fraction of the volume's brightest voxel (0: every local maximum)")
       ->capture_default_str();
   cmd->add_option("--json", args->json_out, "Write the JSON to FILE (.json) and print the tables; '-' or none: JSON on stdout")
       ->expected(0, 1);

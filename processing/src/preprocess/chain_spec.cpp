@@ -277,7 +277,7 @@ ChainSpec read_chain_file(const std::filesystem::path& path) {
   std::ifstream in(path);
   if (!in)
     throw bad_input(fmt::format("cannot read the chain file '{}': check the path, or name a preset (shadow-a, "
-                                "shadow-b)",
+                                "shadow-b, shadow-detect)",
                                 path.string()));
   std::ostringstream text;
   text << in.rdbuf();

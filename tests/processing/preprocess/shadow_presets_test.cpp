@@ -35,23 +35,25 @@ Image shadow_image(double noise, double depth, const std::vector<std::pair<int, 
 
 TEST(ShadowPresets, NamesParseAsChainsAndFollowTheThesisOrder) {
   const ChainSpec a = read_chain("shadow-a");
-  ASSERT_EQ(a.steps.size(), 4u);
-  EXPECT_EQ(a.steps[0].kind, StepKind::median);
-  EXPECT_EQ(a.steps[1].kind, StepKind::normalize);
-  EXPECT_EQ(a.steps[1].by, NormalizeBy::local);
-  EXPECT_EQ(a.steps[2].kind, StepKind::invert);
-  EXPECT_EQ(a.steps[3].kind, StepKind::clip);
-  EXPECT_TRUE(a.steps[3].use_sigmas);
-  EXPECT_DOUBLE_EQ(a.steps[3].sigmas, 2.0);
-  EXPECT_TRUE(a.steps[3].subtract);
+  ASSERT_EQ(a.steps.size(), 3u);
+  EXPECT_EQ(a.steps[0].kind, StepKind::normalize);
+  EXPECT_EQ(a.steps[0].by, NormalizeBy::local);
+  EXPECT_EQ(a.steps[1].kind, StepKind::invert);
+  EXPECT_EQ(a.steps[2].kind, StepKind::clip);
+  EXPECT_TRUE(a.steps[2].use_sigmas);
+  EXPECT_DOUBLE_EQ(a.steps[2].sigmas, 2.0);
+  EXPECT_TRUE(a.steps[2].subtract);
   const ChainSpec b = read_chain("shadow-b");
-  ASSERT_EQ(b.steps.size(), 6u);  // A, then the 20 x 20 local minimum and a constant threshold
-  EXPECT_EQ(b.steps[4].kind, StepKind::subtract_local_minimum);
-  EXPECT_EQ(b.steps[4].size, 20);
-  EXPECT_EQ(b.steps[5].kind, StepKind::clip);
-  EXPECT_FALSE(b.steps[5].use_sigmas);
+  ASSERT_EQ(b.steps.size(), 5u);  // A, then the 20 x 20 local minimum and a constant threshold
+  EXPECT_EQ(b.steps[3].kind, StepKind::subtract_local_minimum);
+  EXPECT_EQ(b.steps[3].size, 20);
+  EXPECT_EQ(b.steps[4].kind, StepKind::clip);
+  EXPECT_FALSE(b.steps[4].use_sigmas);
   // The text a results file records is the preset's; a file name is still read as a file.
   EXPECT_NE(chain_text("shadow-b").find("subtract_local_minimum"), std::string::npos);
+  const ChainSpec d = read_chain("shadow-detect");  // A with the offset at 0 sigma
+  ASSERT_EQ(d.steps.size(), 3u);
+  EXPECT_DOUBLE_EQ(d.steps[2].sigmas, 0.0);
   EXPECT_THROW(read_chain("shadow-c"), Error);
   try {
     chain_text("no-such-chain.toml");
@@ -90,6 +92,20 @@ TEST(ShadowPresets, PresetBKeepsTheShadowsAndClearsTheBackground) {
     }
   // Noise of 1 % beyond 2 sigma + 10 counts (3 sigma): ~0.1 % of the background at most.
   EXPECT_LT(lit, kW * kH / 200) << lit;
+}
+
+TEST(ShadowPresets, PresetASubtractsTwoSigmaOfTheNoiseFromTheInvertedShadows) {
+  // 1 % noise: sigma 10 counts of the bright field at 1000; a 30 % shadow is 300 deep.
+  const std::vector<std::pair<int, int>> shadows{{60, 60}, {180, 120}};
+  ImageChain chain(read_chain("shadow-a"));
+  const Image& out = chain.run(shadow_image(0.01, 0.3, shadows, 11), Exposure::A);
+  for (const auto& [x, y] : shadows) EXPECT_NEAR(out.at<float>(x, y), 300.0f - 20.0f, 25.0f) << x << " " << y;
+  int lit = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) lit += out.at<float>(x, y) > 0;
+  // Beyond 2 sigma of Gaussian noise: 2.3 % of the pixels, the shadows' 26 more.
+  EXPECT_GT(lit, kW * kH / 100);
+  EXPECT_LT(lit, kW * kH * 4 / 100);
 }
 
 TEST(ShadowPresets, LocalNormalizeRejectsABadTileAndSizeWithOtherModes) {

@@ -66,7 +66,8 @@ ChainSpec parse_chain(std::string_view toml_text, const std::string& source);
 ChainSpec read_chain_file(const std::filesystem::path& path);
 
 // Named chains (docs/preprocessing.md, "Presets"): "shadow-a" and "shadow-b", the shadow
-// preprocessing A and B of thesis Sect. 7.4. Wherever a chain file is asked for
+// preprocessing A and B of thesis Sect. 7.4, and "shadow-detect" (A without its 2 sigma offset,
+// for droplet detection down to the visibility limit). Wherever a chain file is asked for
 // (`--chain`), a preset name stands for that chain.
 std::vector<std::string_view> preset_names();
 // The preset's TOML text, or empty if `name` is not a preset.
