@@ -161,19 +161,22 @@ TEST_F(SprayRun, PresetsAndThePsfFindTheDropletsAboveThePredictedLimitAndTheirVe
   int with_velocity = 0;
   for (const json& c : j.at("classes")) {
     const double lower = c.at("d_um")[0].get<double>();
-    if (lower >= 20 && c.at("truth").get<int>() > 0)
+    if (lower >= 20 && c.at("truth").get<int>() > 0) {
       EXPECT_GE(c.at("detected_fraction").get<double>(), 0.95) << c.dump();
+    }
     // Droplets mostly under the limit (>= 9 um here) are mostly not seen: the detection does not
     // match by chance.
-    if (c.at("d_um")[1].get<double>() <= 10.0 + 1e-9 && c.at("truth").get<int>() > 0)
+    if (c.at("d_um")[1].get<double>() <= 10.0 + 1e-9 && c.at("truth").get<int>() > 0) {
       EXPECT_LT(c.at("detected_fraction").get<double>(), 0.5) << c.dump();
+    }
     const json& v = c.at("velocity");
     if (v.at("droplets").get<int>() >= 10) ++with_velocity;
     // The correlation follows the large droplets, whose shadows dominate the volumes: their
     // velocity error is a fraction of their speed (~45 m/s). The small ones, which follow the
     // cross-flow, are averaged with them (Fig. 7.15's discussion; docs/accuracy.md).
-    if (lower >= 30 && v.at("droplets").get<int>() >= 10)
+    if (lower >= 30 && v.at("droplets").get<int>() >= 10) {
       EXPECT_LT(v.at("rms_error_magnitude_m_s").get<double>(), 0.4 * v.at("mean_speed_m_s").get<double>()) << c.dump();
+    }
   }
   EXPECT_GE(with_velocity, 4) << j.dump(1).substr(0, 3000);
   // A PSF file that does not exist is refused, naming it.
