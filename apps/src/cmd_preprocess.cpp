@@ -68,7 +68,7 @@ void run(const PreprocessArgs& args) {
   cli::require_session(args.session, "preprocess");
   // Before the sequence passes, which can take minutes: an existing output is refused now.
   storage::check_output_path(args.out, args.overwrite, "session");
-  const preprocess::ChainSpec spec = preprocess::read_chain_file(args.chain);
+  const preprocess::ChainSpec spec = preprocess::read_chain(args.chain);
   const storage::SessionReader session(args.session);
   const SetRange range = parse_sets(args.sets, session.set_count());
   const auto& cameras = session.info().cameras;
@@ -165,7 +165,8 @@ void add_preprocess_command(CLI::App& root) {
   CLI::App* cmd = root.add_subcommand(
       "preprocess", "Apply an image preprocessing chain (TOML) to a session and write a preprocessed session");
   cli::add_session_argument(*cmd, args->session, "Session file to read (.h5)");
-  cmd->add_option("--chain", args->chain, "Preprocessing chain ([[preprocess.steps]] TOML, docs/preprocessing.md)")
+  cmd->add_option("--chain", args->chain, "Preprocessing chain ([[preprocess.steps]] TOML, docs/preprocessing.md) or a preset: shadow-a, shadow-b "
+                  "(thesis Sect. 7.4)")
       ->required();
   cmd->add_option("-o,--out", args->out, "Preprocessed session to write (.h5)")->required();
   cmd->add_option("--sets", args->sets, "Sets: N (the first N), A:B (A to B-1) or consecutive A-B; default all");

@@ -105,7 +105,8 @@ void add_process_command(CLI::App& root) {
                   "Calibration file (TOML), or 'truth' for a simulated session's exact cameras (default: the truth "
                   "if present, else the rig config's calibration file)");
   cmd->add_option("--chain", args->chain,
-                  "Preprocessing chain ([[preprocess.steps]] TOML, as for 'tomorig preprocess --chain'); default: none");
+                  "Preprocessing chain ([[preprocess.steps]] TOML, as for 'tomorig preprocess --chain') or a preset: "
+                  "shadow-a, shadow-b (thesis Sect. 7.4); default: none");
   cli::add_deprecated_option(*cmd, "--config", args->chain, "--chain (--config names the rig file elsewhere)");
   cmd->add_option("-o,--out", args->out, "Results file (.h5); an existing one of the same session and parameters is "
                                          "resumed")

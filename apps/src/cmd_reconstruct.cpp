@@ -93,6 +93,7 @@ void run(const ReconstructArgs& args) {
                                {"max_iterations", options.max_iterations},
                                {"relaxation", options.relaxation},
                                {"sigma_px", args.recon.sigma_px},
+                               {"psf", args.recon.psf},
                                {"smoothing_sigma_voxel", args.smooth},
                                {"cameras", cameras.source},
                                {"dt_ns", set.dt_ns}};

@@ -18,6 +18,7 @@
 #include "tomorig/pipeline/session_preprocessor.h"
 #include "tomorig/pipeline/slice_png.h"
 #include "tomorig/pipeline/two_stage_pipeline.h"
+#include "tomorig/processing/preprocess/chain_spec.h"
 #include "tomorig/storage/results_file.h"
 #include "tomorig/storage/session_file.h"
 
@@ -26,16 +27,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-std::string file_text(const fs::path& path) {
-  if (path.empty()) return "";
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    throw bad_input(fmt::format("--config '{}' cannot be read; give the preprocessing chain TOML", path.string()));
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 // The results file must match this run: same session first (the clearer message), then the grid.
 void check_existing_results(const fs::path& out, const std::string& identity, const nlohmann::json& grid) {
@@ -205,7 +196,7 @@ std::unique_ptr<storage::ResultsWriter> open_results(const BackendInputs& inputs
   const std::string identity = session_identity(inputs.session);
   nlohmann::json parameters = inputs.processor.parameters();
   parameters["preprocess"] = {{"chain_file", options.preprocess_chain.string()},
-                              {"chain_toml", file_text(options.preprocess_chain)}};
+                              {"chain_toml", preprocess::chain_text(options.preprocess_chain.string())}};
   parameters["dt_override_ns"] = options.dt_ns;
   std::error_code ec;
   if (!options.overwrite && fs::exists(options.out, ec)) check_existing_results(options.out, identity, parameters["grid"]);

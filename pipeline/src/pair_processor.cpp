@@ -105,6 +105,7 @@ nlohmann::json PairProcessor::parameters() const {
   return {{"grid", grid_json(setup_.input.grid)},
           {"reconstruction", {{"algorithm", r.algorithm}, {"max_iterations", r.max_iterations},
                               {"relaxation", r.relaxation}, {"sigma_px", options_.reconstruction.sigma_px},
+                              {"psf", options_.reconstruction.psf},
                               {"smoothing_sigma_voxel", options_.smooth}, {"cameras", cameras_.source}}},
           {"correlation", to_json(correlation_)}};
 }

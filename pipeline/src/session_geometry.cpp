@@ -3,6 +3,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <fstream>
 #include <sstream>
 
 #include <CLI/CLI.hpp>
@@ -13,6 +14,7 @@
 #include "tomorig/processing/calibration/calibration_file.h"
 #include "tomorig/processing/calibration/pinhole_camera.h"
 #include "tomorig/processing/optics/psf_table.h"
+#include "tomorig/pipeline/spray_psf.h"
 
 namespace tomorig::pipeline {
 namespace {
@@ -187,12 +189,24 @@ void add_reconstruction_flags(CLI::App& cmd, ReconstructionChoices& choices, con
   cmd.add_option("--sigma-px", choices.sigma_px,
                  "Gaussian sigma of the voxel-to-pixel weights (PSF), pixels, all cameras")
       ->capture_default_str();
-  cmd.add_option("--psf", choices.psf_file,
-                 "PSF file from `tomorig optics psf --psf-out`: each camera's measured sigma over depth (instead of "
-                 "--sigma-px)");
+  cmd.add_option("--psf", choices.psf,
+                 "Depth-varying PSF per camera instead of --sigma-px: a PSF file ('tomorig optics psf --psf-out'), "
+                 "an optics set-up file ('tomorig optics psf --setup-out') or 'truth' (a simulated spray session's); "
+                 "docs/spray.md");
 }
 
 namespace {
+
+// A PSF file holds the reconstruction's sigma itself (sigma_px per depth); an optics set-up
+// file holds chi(z), which spray_psf.h turns into sigma. "truth" is neither.
+bool is_psf_file(const std::string& psf) {
+  if (psf == "truth") return false;
+  std::ifstream in(psf);
+  std::string line;
+  while (std::getline(in, line))
+    if (line.find("sigma_px") != std::string::npos) return true;
+  return false;  // a set-up file, or a file the set-up reader refuses with a message
+}
 
 // Each session camera's depth-varying PSF from a PSF file, matched by camera id.
 std::vector<recon::PsfModel> measured_psf(const SessionDescription& session, const std::string& file) {
@@ -237,10 +251,16 @@ ReconstructionSetup reconstruction_setup(const SessionDescription& session, cons
   recon::ReconstructionInput& input = setup.input;
   input.cameras = cameras.pointers();
   input.grid = choices.grid.empty() ? grid_from_session(session) : parse_grid(choices.grid);
-  input.psf.assign(input.cameras.size(), recon::PsfModel::constant(choices.sigma_px));
+  if (choices.psf.empty()) {
+    input.psf.assign(input.cameras.size(), recon::PsfModel::constant(choices.sigma_px));
+    if (!input.psf.empty()) input.psf.front().validate("--sigma-px");
+  } else if (is_psf_file(choices.psf)) {
+    input.psf = measured_psf(session, choices.psf);
+  } else {
+    input.psf = psf_from_optics_setup(spray_optics_setup(choices.psf, session.truth), session.cameras, input.cameras,
+                                      input.grid);
+  }
   for (const storage::SessionCamera& c : session.cameras) input.sensor_sizes.push_back({c.width, c.height});
-  if (!input.psf.empty()) input.psf.front().validate("--sigma-px");
-  if (!choices.psf_file.empty()) input.psf = measured_psf(session, choices.psf_file);
   return setup;
 }
 

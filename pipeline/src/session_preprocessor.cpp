@@ -39,7 +39,7 @@ Image reference_image(const fs::path& file, const std::string& camera_id, std::s
 
 SessionPreprocessor::SessionPreprocessor(const storage::SessionReader& session, const fs::path& chain_file) {
   if (chain_file.empty()) return;
-  const preprocess::ChainSpec spec = preprocess::read_chain_file(chain_file);
+  const preprocess::ChainSpec spec = preprocess::read_chain(chain_file.string());
   if (spec.steps.empty()) return;
   for (const storage::SessionCamera& camera : session.info().cameras) {
     chains_.emplace_back(spec);

@@ -9,6 +9,8 @@
 #include "tomorig/core/error.h"
 #include "tomorig/pipeline/session_geometry.h"
 #include "temp_dir.h"
+#include "tomorig/pipeline/spray_psf.h"
+#include "tomorig/processing/calibration/pinhole_camera.h"
 
 namespace tomorig::testing {
 namespace {
@@ -80,7 +82,7 @@ TEST(ReconstructionSetup, APsfFileGivesEachCameraItsMeasuredSigmaOverDepth) {
   const pipeline::SessionDescription d = pipeline::describe_recording(
       "two cameras", {{"cam1", 64, 64}, {"cam2", 64, 64}}, config::default_rig_toml(), std::nullopt);
   pipeline::ReconstructionChoices choices;
-  choices.psf_file = file;
+  choices.psf = file;
   const recon::ReconstructionInput in = pipeline::reconstruction_setup(d, {}, choices).input;
   ASSERT_EQ(in.psf.size(), 2u);
   EXPECT_DOUBLE_EQ(in.psf[0].at(3.0).sigma_u_px, 0.6);
@@ -98,8 +100,39 @@ TEST(ReconstructionSetup, APsfFileGivesEachCameraItsMeasuredSigmaOverDepth) {
     EXPECT_NE(std::string(e.what()).find("'cam3'"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("cam2, cam1"), std::string::npos) << e.what();
   }
-  choices.psf_file = (dir.path() / "missing.toml").string();
+  choices.psf = (dir.path() / "missing.toml").string();
   EXPECT_THROW(pipeline::reconstruction_setup(d, {}, choices), Error);
+}
+
+// --psf: chi(z) in object um becomes each camera's weight sigma in its own pixels at that depth.
+TEST(SprayPsf, ChiBecomesSigmaInPixelsOfEachCameraAtEachDepth) {
+  // A pinhole of f = 100 mm at 211 mm: scale 100 / 211 at z = 0, a 6.5 um pixel sees 13.7 um.
+  const auto cam = calibration::PinholeCamera::yawed(0.0, 100.0, 6.5, 211.0, 640, 540);
+  optics::VisibilitySetup setup;
+  optics::CameraOptics o;
+  o.id = "cam1";
+  o.chi = {{-4.5, 60.0}, {0.0, 40.0}, {4.5, 60.0}};
+  setup.cameras.push_back(o);
+  const std::vector<storage::SessionCamera> cameras{{"cam1", 640, 540, PixelFormat::Mono16, 6.5}};
+  const VoxelGrid grid = VoxelGrid::centred(10, 10, 10, 0.1);
+  const std::vector<recon::PsfModel> psf = pipeline::psf_from_optics_setup(setup, cameras, {&cam}, grid);
+  ASSERT_EQ(psf.size(), 1u);
+  ASSERT_EQ(psf[0].samples.size(), 3u);
+  const double object_px_um = 6.5 * 211.0 / 100.0;
+  EXPECT_NEAR(psf[0].samples[1].sigma_u_px, 20.0 / object_px_um, 1e-3);
+  EXPECT_EQ(psf[0].samples[1].sigma_u_px, psf[0].samples[1].sigma_v_px);
+  // The magnification changes with depth (the camera looks along z): the same chi is more
+  // pixels on the near side than on the far side.
+  EXPECT_NE(psf[0].samples[0].sigma_u_px, psf[0].samples[2].sigma_u_px);
+  EXPECT_NEAR(psf[0].samples[0].sigma_u_px + psf[0].samples[2].sigma_u_px, 2 * 30.0 / object_px_um, 0.05);
+
+  // A set-up without the session's camera, and a PSF wider than the reconstruction allows.
+  const std::vector<storage::SessionCamera> other{{"cam9", 640, 540, PixelFormat::Mono16, 6.5}};
+  EXPECT_THROW(pipeline::psf_from_optics_setup(setup, other, {&cam}, grid), Error);
+  setup.cameras[0].chi = {{0.0, 400.0}};  // sigma 14.6 px
+  EXPECT_THROW(pipeline::psf_from_optics_setup(setup, cameras, {&cam}, grid), Error);
+  // --psf truth needs a session with a spray truth.
+  EXPECT_THROW(pipeline::spray_optics_setup("truth", std::nullopt), Error);
 }
 
 }  // namespace

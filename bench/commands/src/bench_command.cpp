@@ -13,6 +13,7 @@ void add_bench_piv3d_command(CLI::App& bench);   // bench_piv3d.cpp
 void add_bench_recon_race_command(CLI::App& bench);  // bench_recon_race.cpp
 void add_bench_calib_command(CLI::App& bench);   // bench_calib.cpp
 void add_bench_quicklook_command(CLI::App& bench);  // bench_quicklook.cpp
+void add_bench_spray_command(CLI::App& bench);  // bench_spray.cpp
 
 void add_bench_command(CLI::App& root) {
   CLI::App* bench = root.add_subcommand("bench", "Measure speed and accuracy on simulated cases; print JSON");
@@ -24,6 +25,7 @@ void add_bench_command(CLI::App& root) {
   add_bench_recon_race_command(*bench);
   add_bench_calib_command(*bench);
   add_bench_quicklook_command(*bench);
+  add_bench_spray_command(*bench);
 }
 
 }  // namespace tomorig::bench

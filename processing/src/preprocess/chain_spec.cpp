@@ -47,7 +47,7 @@ std::set<std::string> allowed_keys(StepKind kind) {
     case StepKind::median: return {"size"};
     case StepKind::lowpass:
     case StepKind::highpass: return {"sigma"};
-    case StepKind::normalize: return {"by", "target"};
+    case StepKind::normalize: return {"by", "target", "size"};
     case StepKind::flat_field: return {"file"};
     case StepKind::invert: return {"max"};
     case StepKind::clip: return {"level", "sigmas", "subtract"};
@@ -145,7 +145,13 @@ Step read_step(const StepReader& r, config::TomlNode table) {
         const std::string by = r.string("by");
         if (by == "mean") step.by = NormalizeBy::mean;
         else if (by == "average_image") step.by = NormalizeBy::average_image;
-        else r.fail("by", r.node("by"), fmt::format("'{}' is not allowed; use \"mean\" or \"average_image\"", by));
+        else if (by == "local") step.by = NormalizeBy::local;
+        else r.fail("by", r.node("by"), fmt::format("'{}' is not allowed; use \"mean\", \"average_image\" or \"local\"", by));
+      }
+      step.size = kLocalNormalizeTile;
+      if (r.has("size")) {
+        if (step.by != NormalizeBy::local) r.fail("size", r.node("size"), "applies to by = \"local\" only (its tile size)");
+        step.size = r.integer("size");
       }
       if (r.has("target")) step.target = r.number("target");
       break;
@@ -210,6 +216,8 @@ void validate(const Step& step, std::size_t index) {
       break;
     case StepKind::normalize:
       if (!(step.target > 0)) fail("target", fmt::format("must be > 0, got {}", step.target));
+      if (step.by == NormalizeBy::local && (step.size < 8 || step.size > 1024))
+        fail("size", fmt::format("must be an integer from 8 to 1024 pixels, got {}", step.size));
       break;
     case StepKind::flat_field:
       if (step.file.empty()) fail("file", "is empty: give the session file of bright-field frames");
@@ -267,7 +275,10 @@ ChainSpec parse_chain(std::string_view toml_text, const std::string& source) {
 
 ChainSpec read_chain_file(const std::filesystem::path& path) {
   std::ifstream in(path);
-  if (!in) throw bad_input(fmt::format("cannot read the chain file '{}': check the path", path.string()));
+  if (!in)
+    throw bad_input(fmt::format("cannot read the chain file '{}': check the path, or name a preset (shadow-a, "
+                                "shadow-b, shadow-detect)",
+                                path.string()));
   std::ostringstream text;
   text << in.rdbuf();
   return parse_chain(text.str(), path.string());

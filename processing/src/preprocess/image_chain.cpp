@@ -120,6 +120,54 @@ const Image& ImageChain::required(const Image& image, std::size_t index, const c
   return image;
 }
 
+void ImageChain::local_bright_field(int tile) {
+  if (scratch_.empty() || scratch_.width() != current_.width() || scratch_.height() != current_.height())
+    scratch_ = Image::allocate(current_.width(), current_.height(), SampleType::f32);
+  const int w = current_.width(), h = current_.height();
+  const int tiles_x = std::max(1, (w + tile / 2) / tile), tiles_y = std::max(1, (h + tile / 2) / tile);
+  // The median of each tile (tiles split the frame evenly, so the last ones are not slivers).
+  tile_levels_.resize(static_cast<std::size_t>(tiles_x) * static_cast<std::size_t>(tiles_y));
+  for (int ty = 0; ty < tiles_y; ++ty)
+    for (int tx = 0; tx < tiles_x; ++tx) {
+      const int x0 = tx * w / tiles_x, x1 = (tx + 1) * w / tiles_x, y0 = ty * h / tiles_y, y1 = (ty + 1) * h / tiles_y;
+      sort_buffer_.clear();
+      for (int y = y0; y < y1; ++y) {
+        const float* row = current_.row<float>(y);
+        sort_buffer_.insert(sort_buffer_.end(), row + x0, row + x1);
+      }
+      const auto mid = sort_buffer_.begin() + static_cast<std::ptrdiff_t>(sort_buffer_.size() / 2);
+      std::nth_element(sort_buffer_.begin(), mid, sort_buffer_.end());
+      tile_levels_[static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x) + static_cast<std::size_t>(tx)] = *mid;
+    }
+  // Bilinear between the tile centres and extrapolated linearly into the outer half-tiles
+  // (vignetting keeps falling there; holding the last level would leave a rim of background).
+  const double tw = static_cast<double>(w) / tiles_x, th = static_cast<double>(h) / tiles_y;
+  const auto cell = [](double u, int tiles, int& i0) {
+    i0 = tiles < 2 ? 0 : std::clamp(static_cast<int>(std::floor(u)), 0, tiles - 2);
+    return tiles < 2 ? 0.0 : u - i0;
+  };
+  const auto level = [&](int tx, int ty) {
+    return static_cast<double>(tile_levels_[static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x) +
+                                            static_cast<std::size_t>(tx)]);
+  };
+  for (int y = 0; y < h; ++y) {
+    int j0 = 0;
+    const double fy = cell((y + 0.5) / th - 0.5, tiles_y, j0);
+    const int j1 = std::min(j0 + 1, tiles_y - 1);
+    float* out = scratch_.row<float>(y);
+    for (int x = 0; x < w; ++x) {
+      int i0 = 0;
+      const double fx = cell((x + 0.5) / tw - 0.5, tiles_x, i0);
+      const int i1 = std::min(i0 + 1, tiles_x - 1);
+      const double top = level(i0, j0) + fx * (level(i1, j0) - level(i0, j0));
+      const double bottom = level(i0, j1) + fx * (level(i1, j1) - level(i0, j1));
+      // Never below a tenth of the nearest tile's level: an extrapolation must not divide by ~0.
+      const double nearest = level(fx < 0.5 ? i0 : i1, fy < 0.5 ? j0 : j1);
+      out[x] = static_cast<float>(std::max(top + fy * (bottom - top), 0.1 * nearest));
+    }
+  }
+}
+
 void ImageChain::apply(std::size_t index, Exposure e) {
   const Step& step = spec_.steps[index];
   const auto ensure_scratch = [&] {
@@ -173,6 +221,9 @@ void ImageChain::apply(std::size_t index, Exposure e) {
         const double mean = mean_of(current_);
         const float scale = mean > 0 ? static_cast<float>(step.target / mean) : 0.0f;
         transform(current_, [scale](float v) { return v * scale; });
+      } else if (step.by == NormalizeBy::local) {
+        local_bright_field(step.size);
+        combine(current_, scratch_, [target](float v, float bright) { return bright > 0 ? v / bright * target : 0.0f; });
       } else {
         combine(current_, required(sequence_[index][static_cast<int>(e)], index, "sequence average image"),
                 [target](float v, float avg) { return avg > 0 ? v / avg * target : 0.0f; });

@@ -92,7 +92,7 @@ TEST(QuickLookAccuracy, TpivThesisRigCamerasMatchTheirTruth) {
       ql.analyse(frames.a.image, frames.b.image, s);
       const double truth = rig_truth_ppp(rig, set.particles_a, c);
       std::printf("| tpiv-thesis, %s sheet, %s | %.4f | %.4f | %.4f | %.4f | %+.1f %% | %.2f | %+.1f %% | %.3f |\n",
-                  std::string(sim::to_string(k.sheet)).c_str(), frames.camera_id.c_str(), truth, s.a.maxima_per_pixel,
+                  k.sheet == sim::LightSheetProfile::uniform ? "uniform" : "gaussian", frames.camera_id.c_str(), truth, s.a.maxima_per_pixel,
                   s.a.ppp_autocovariance, s.a.ppp.value, 100 * (s.a.ppp.value / truth - 1), s.a.diameter_px.value,
                   100 * (s.a.diameter_px.value / d_truth - 1), s.energy_balance.value);
       EXPECT_NEAR(s.a.diameter_px.value, d_truth, 0.10 * d_truth) << "camera " << c;

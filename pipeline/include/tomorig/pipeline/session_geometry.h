@@ -91,9 +91,10 @@ struct ReconstructionChoices {
   int iterations = 0;  // named on the command line; 0: the rig config's, else options.max_iterations
   std::string grid;    // empty: the rig config's [grid]; else as parse_grid
   double sigma_px = recon::kDefaultPsfSigmaPx;  // weight (PSF) sigma of every camera, pixels
-  // A PSF file (`tomorig optics psf --psf-out`): each camera's sigma over depth, instead of
-  // sigma_px. Empty: sigma_px for every camera.
-  std::string psf_file;
+  // Empty: sigma_px everywhere. Else each camera's PSF over depth, replacing sigma_px: a PSF
+  // file (`tomorig optics psf --psf-out`, sigma_px per depth), an optics set-up file (chi(z)
+  // per camera, `tomorig optics psf --setup-out`) or "truth" (a simulated spray session's).
+  std::string psf;
 };
 
 // Registers --algorithm, --iterations, --relaxation, --mlos-threshold, --grid, --sigma-px and --psf,

@@ -23,11 +23,18 @@ enum class StepKind {
   clip,                    // values below a threshold (constant, or median + k robust sigma) set to 0
 };
 
-enum class NormalizeBy { mean, average_image };
+// mean: the frame's mean; average_image: the sequence's average image; local: the frame's own
+// bright field, the median of each size x size tile interpolated between the tile centres (a
+// flat-field for shadowgraphs without a separate bright-field recording: shadows cover a small
+// part of any tile).
+enum class NormalizeBy { mean, average_image, local };
+
+// Tile of normalize by = "local" when the chain file names none, pixels.
+inline constexpr int kLocalNormalizeTile = 64;
 
 struct Step {
   StepKind kind = StepKind::median;
-  int size = 3;               // subtract_local_minimum, median
+  int size = 3;               // subtract_local_minimum, median; normalize by local: the tile (default 64)
   double sigma = 1.0;         // lowpass, highpass
   NormalizeBy by = NormalizeBy::mean;
   double target = 1000.0;     // normalize: the mean (or average-image level) maps to this
@@ -57,5 +64,17 @@ void validate(const Step& step, std::size_t index);
 // (preprocess.steps[i].key), its line and what is allowed; unknown keys are errors.
 ChainSpec parse_chain(std::string_view toml_text, const std::string& source);
 ChainSpec read_chain_file(const std::filesystem::path& path);
+
+// Named chains (docs/preprocessing.md, "Presets"): "shadow-a" and "shadow-b", the shadow
+// preprocessing A and B of thesis Sect. 7.4, and "shadow-detect" (A without its 2 sigma offset,
+// for droplet detection down to the visibility limit). Wherever a chain file is asked for
+// (`--chain`), a preset name stands for that chain.
+std::vector<std::string_view> preset_names();
+// The preset's TOML text, or empty if `name` is not a preset.
+std::string_view preset_chain_toml(std::string_view name);
+// A preset (by name) or a chain file: read_chain_file unless `chain` names a preset.
+ChainSpec read_chain(const std::string& chain);
+// The chain's TOML text, for records of what was run: the preset's or the file's.
+std::string chain_text(const std::string& chain);
 
 }  // namespace tomorig::preprocess

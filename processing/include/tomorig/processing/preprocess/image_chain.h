@@ -36,6 +36,8 @@ class ImageChain {
 
  private:
   void apply(std::size_t index, Exposure e);
+  // normalize by local: the frame's bright field (tile medians, interpolated) into scratch_.
+  void local_bright_field(int tile);
   const Image& required(const Image& image, std::size_t index, const char* what) const;
 
   ChainSpec spec_;
@@ -45,6 +47,7 @@ class ImageChain {
   Image current_;                                   // the working image
   Image scratch_;                                   // second buffer for filters
   std::vector<float> sort_buffer_;                  // clip: background statistics
+  std::vector<float> tile_levels_;                  // normalize by local: the tiles' medians
 };
 
 // Float to uint16: values rounded to nearest and clipped to [0, 65535]; `out` is reused when
