@@ -97,10 +97,7 @@ void run(const ReconstructArgs& args) {
                                {"smoothing_sigma_voxel", args.smooth},
                                {"cameras", cameras.source},
                                {"dt_ns", set.dt_ns}};
-  if (!args.recon.psf_file.empty()) {  // each camera's measured sigma over depth instead
-    parameters["sigma_px"] = nullptr;
-    parameters["psf"] = args.recon.psf_file;
-  }
+  if (!args.recon.psf.empty()) parameters["sigma_px"] = nullptr;  // each camera's sigma over depth instead
   storage::VolumeFileWriter out(args.out, {args.session, args.set, parameters.dump()},
                                 {.overwrite = args.overwrite, .dense_export = !args.sparse_only});
   nlohmann::json reports = nlohmann::json::object();

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tomorig/core/error.h"
+#include "tomorig/rig/simulate_spray.h"
 
 namespace tomorig::bench {
 
@@ -21,7 +22,7 @@ sim::SprayCase spray_case_of(const storage::SessionTruth& truth) {
   try {
     sim::SprayOptions o;
     o.seed = truth.seed;
-    o.pattern = sim::parse_spray_pattern(p.at("pattern").get<std::string>());
+    o.pattern = rig::parse_spray_pattern(p.at("pattern").get<std::string>(), "the session's spray truth (pattern)");
     o.reduced = p.at("reduced").get<bool>();
     o.droplets = p.at("droplets_per_set").get<int>();
     o.d_median_um = p.at("d_median_um").get<double>();
