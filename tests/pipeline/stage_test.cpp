@@ -117,41 +117,47 @@ class HeldStage final : public Stage {
   std::size_t max_waiting_sets() const override { return waiting; }
 };
 
-TEST(StageRunner, ASkippingStageTakesTheNewestSetAndCountsTheOthers) {
+// Offers set 1, waits until the stage is held inside it, offers sets 2 to `last` meanwhile,
+// then releases the stage and ends the runner (which processes what still waits).
+struct HeldRun {
+  pipeline::StageReport report;
+  std::vector<std::uint64_t> seen;
+  bool ended = false;
+};
+HeldRun offer_while_held(std::uint64_t last, std::size_t waiting) {
   auto owned = std::make_unique<HeldStage>();
+  owned->waiting = waiting;
   HeldStage& stage = *owned;
   std::future<void> entered = stage.entered.get_future();
   pipeline::StageRunner runner("held", std::move(owned));
   runner.begin({});
   runner.offer(row_set(4, 0, 1, 1, 1));
   entered.wait();  // set 1 is being processed
-  for (std::uint64_t t = 2; t <= 5; ++t) runner.offer(row_set(4, 0, 1, 1, t));
+  for (std::uint64_t t = 2; t <= last; ++t) runner.offer(row_set(4, 0, 1, 1, t));
   stage.release.set_value();
-  const pipeline::StageReport report = runner.end();
-  EXPECT_EQ(stage.seen, (std::vector<std::uint64_t>{1, 5}));  // 2, 3, 4 were overtaken
-  EXPECT_EQ(report.offered, 5u);
-  EXPECT_EQ(report.processed, 2u);
-  EXPECT_EQ(report.skipped, 3u);
-  EXPECT_TRUE(stage.ended);
-  EXPECT_NE(report.brief().find("3 skipped"), std::string::npos) << report.brief();
+  HeldRun run;
+  run.report = runner.end();
+  run.seen = stage.seen;
+  run.ended = stage.ended;
+  return run;
+}
+
+TEST(StageRunner, ASkippingStageTakesTheNewestSetAndCountsTheOthers) {
+  const HeldRun run = offer_while_held(5, 1);
+  EXPECT_EQ(run.seen, (std::vector<std::uint64_t>{1, 5}));  // 2, 3, 4 were overtaken
+  EXPECT_EQ(run.report.offered, 5u);
+  EXPECT_EQ(run.report.processed, 2u);
+  EXPECT_EQ(run.report.skipped, 3u);
+  EXPECT_TRUE(run.ended);
+  EXPECT_NE(run.report.brief().find("3 skipped"), std::string::npos) << run.report.brief();
 }
 
 TEST(StageRunner, AStageThatMayLagKeepsItsNewestSetsWaitingAndSkipsOnlyTheOldest) {
-  auto owned = std::make_unique<HeldStage>();
-  owned->waiting = 3;
-  HeldStage& stage = *owned;
-  std::future<void> entered = stage.entered.get_future();
-  pipeline::StageRunner runner("held", std::move(owned));
-  runner.begin({});
-  runner.offer(row_set(4, 0, 1, 1, 1));
-  entered.wait();  // set 1 is being processed
-  for (std::uint64_t t = 2; t <= 6; ++t) runner.offer(row_set(4, 0, 1, 1, t));
-  stage.release.set_value();
-  const pipeline::StageReport report = runner.end();  // the waiting sets are processed first
-  EXPECT_EQ(stage.seen, (std::vector<std::uint64_t>{1, 4, 5, 6}));  // 2 and 3 gave way, in order
-  EXPECT_EQ(report.offered, 6u);
-  EXPECT_EQ(report.processed, 4u);
-  EXPECT_EQ(report.skipped, 2u);
+  const HeldRun run = offer_while_held(6, 3);
+  EXPECT_EQ(run.seen, (std::vector<std::uint64_t>{1, 4, 5, 6}));  // 2 and 3 gave way, in order
+  EXPECT_EQ(run.report.offered, 6u);
+  EXPECT_EQ(run.report.processed, 4u);
+  EXPECT_EQ(run.report.skipped, 2u);
 }
 
 TEST(StageRunner, ALosslessStageSeesEverySetAndItsErrorsReachTheCaller) {
