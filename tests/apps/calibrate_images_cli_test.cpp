@@ -57,6 +57,28 @@ class CalibrateImagesCli : public ::testing::Test {
     }
     return root;
   }
+  // The staggered plate of the two-level tests (2 mm nearest-dot spacing, a second level 0.5 mm
+  // behind the first, a filled square origin and a +x triangle), rendered like render_folder at
+  // z = -2, 0, 2 mm; camera c's noise seed is first_seed + c.
+  fs::path render_staggered_two_level_plate(const std::string& name, unsigned first_seed) {
+    sim::DotPlate plate;
+    plate.spec.spacing_mm = 2.0;
+    plate.spec.lattice = calibration::DotLattice::staggered;
+    plate.spec.level_offset_mm = -0.5;
+    plate.triangle_site = 2;
+    plate.noise_counts = 8;
+    const fs::path root = dir_ / name;
+    const auto cams = cameras();
+    for (std::size_t c = 0; c < cams.size(); ++c) {
+      fs::create_directories(root / fmt::format("cam{}", c));
+      for (const double z : {-2.0, 0.0, 2.0}) {
+        plate.seed = first_seed + c;
+        storage::write_png(root / fmt::format("cam{}", c) / fmt::format("{}mm_cam{}.png", z, c),
+                           sim::render_dot_plate(cams[c], plate, z, kWidth, kHeight));
+      }
+    }
+    return root;
+  }
   TempDir dir_;
 };
 
@@ -162,22 +184,8 @@ TEST_F(CalibrateImagesCli, BadInputNamesCameraAndPlane) {
 // true camera within 0.05 px; the same images described by --spacing alone (a square lattice)
 // are refused naming the staggered lattice and the sqrt(2).
 TEST_F(CalibrateImagesCli, StaggeredTwoLevelPlateFromATargetFile) {
-  sim::DotPlate plate;
-  plate.spec.spacing_mm = 2.0;
-  plate.spec.lattice = calibration::DotLattice::staggered;
-  plate.spec.level_offset_mm = -0.5;
-  plate.triangle_site = 2;
-  plate.noise_counts = 8;
-  const fs::path images = dir_ / "plate";
+  const fs::path images = render_staggered_two_level_plate("plate", 11);
   const auto cams = cameras();
-  for (std::size_t c = 0; c < cams.size(); ++c) {
-    fs::create_directories(images / fmt::format("cam{}", c));
-    for (const double z : {-2.0, 0.0, 2.0}) {
-      plate.seed = 11 + c;
-      storage::write_png(images / fmt::format("cam{}", c) / fmt::format("{}mm_cam{}.png", z, c),
-                         sim::render_dot_plate(cams[c], plate, z, kWidth, kHeight));
-    }
-  }
   const fs::path target = dir_ / "plate.toml";
   std::ofstream(target) << "kind = \"dots\"\npitch_mm = 2.0\nlattice = \"staggered\"\nlevel_offset_mm = -0.5\n"
                            "y_axis = \"down\"\n";
@@ -239,22 +247,8 @@ TEST_F(CalibrateImagesCli, StaggeredTwoLevelPlateFromATargetFile) {
 // 0.05 px; a malformed file, a file that misses a detected point, and a level offset given
 // beside the file are refused (exit 2) naming the file and line or the point, nothing written.
 TEST_F(CalibrateImagesCli, TwoLevelPlateWithPointDepthsFromASideFile) {
-  sim::DotPlate plate;
-  plate.spec.spacing_mm = 2.0;
-  plate.spec.lattice = calibration::DotLattice::staggered;
-  plate.spec.level_offset_mm = -0.5;
-  plate.triangle_site = 2;
-  plate.noise_counts = 8;
-  const fs::path images = dir_ / "plate_z";
+  const fs::path images = render_staggered_two_level_plate("plate_z", 21);
   const auto cams = cameras();
-  for (std::size_t c = 0; c < cams.size(); ++c) {
-    fs::create_directories(images / fmt::format("cam{}", c));
-    for (const double z : {-2.0, 0.0, 2.0}) {
-      plate.seed = 21 + c;
-      storage::write_png(images / fmt::format("cam{}", c) / fmt::format("{}mm_cam{}.png", z, c),
-                         sim::render_dot_plate(cams[c], plate, z, kWidth, kHeight));
-    }
-  }
   // Every site of both levels, the second 0.5 mm below the first; BOM and CRLF as from Excel.
   const fs::path depths = dir_ / "depths.csv";
   {
