@@ -7,8 +7,8 @@
 #   inspect --png --set 1                read the frames of a set
 #   preprocess                           read every set and write a new session
 #   replay (into a tomorig record)       read and stream every set
-#   reconstruct --grid 16,12,8           a tiny reconstruction of set 0
-#   process --grid 16,12,8 --sets 1      reconstruction and correlation into a results file
+#   reconstruct --grid 32,24,16          a small reconstruction of set 0
+#   process --grid 32,24,16 --sets 1     reconstruction and correlation into a results file
 # Every run must exit 0 or 2: a signal, a timeout or another exit code is counted as a failure
 # and its file is kept in the work folder. Counts only, no timings: safe on a loaded machine.
 #
@@ -26,9 +26,18 @@ echo "work folder: $work"
 cd "$work" || exit 1
 
 # Four 32 x 24 cameras: the default rig's structure, files of about 100-200 KiB, mostly metadata.
-"$tomorig" config default | sed 's/width = 512/width = 32/; s/height = 512/height = 24/' > rig.toml
+# Pixels 16 times the default's pitch keep the default's field of view, so the images hold the
+# default's particles (at its pitch a 32 x 24 corner sees none) and an undamaged file
+# reconstructs and correlates: reconstruct and process then read past the checks.
+"$tomorig" config default |
+  sed -E 's/width = 512/width = 32/; s/height = 512/height = 24/; s/pixel_pitch_um = 7.4( |$)/pixel_pitch_um = 118.4\1/' > rig.toml
 printf '[[preprocess.steps]]\nkind = "subtract_minimum"\n' > chain.toml
 "$tomorig" simulate --sets 2 --config rig.toml -o simulate.h5 > /dev/null 2>&1 || { echo "simulate failed"; exit 1; }
+# The undamaged file must go all the way through, or the fuzz below would only test refusals.
+"$tomorig" reconstruct simulate.h5 --calib truth --grid 32,24,16,0.2 --set 0 --threads 1 -o vol.h5 > /dev/null 2>&1 &&
+  "$tomorig" process simulate.h5 --calib truth --grid 32,24,16,0.2 --window 8,8,8 --sets 1 --threads 1 -o res.h5 \
+    > /dev/null 2>&1 || { echo "the undamaged session does not reconstruct and process"; exit 1; }
+rm -f vol.h5 vol.xdmf res.h5 res.xdmf
 
 # A live recording killed (SIGKILL) once it holds at least 3 durable sets.
 "$tomorig" run --sets 100000 --status none --config rig.toml -o live.h5 > /dev/null 2>&1 &
@@ -103,8 +112,8 @@ run_command() {
     1) check "$label" inspect damaged.h5 --png png --set 1 ;;
     2) check "$label" preprocess damaged.h5 --chain chain.toml -o out.h5 ;;
     3) replay_into_record "$label" ;;
-    4) check "$label" reconstruct damaged.h5 --calib truth --grid 16,12,8,0.6 --set 0 --threads 1 -o vol.h5 ;;
-    5) check "$label" process damaged.h5 --calib truth --grid 16,12,8,0.6 --window 8,8,8 --sets 1 \
+    4) check "$label" reconstruct damaged.h5 --calib truth --grid 32,24,16,0.2 --set 0 --threads 1 -o vol.h5 ;;
+    5) check "$label" process damaged.h5 --calib truth --grid 32,24,16,0.2 --window 8,8,8 --sets 1 \
          --threads 1 -o res.h5 ;;
   esac
 }
