@@ -10,6 +10,7 @@
 
 #include "commands.h"
 #include "json_summary.h"
+#include "tomorig/core/camera_id.h"
 #include "tomorig/core/error.h"
 #include "tomorig/pipeline/quicklook_history.h"
 #include "tomorig/processing/quicklook/display.h"
@@ -100,8 +101,8 @@ nlohmann::json to_json(const storage::SessionSummary& s) {
 void print_text(const storage::SessionSummary& s) {
   fmt::print("session      {} ({})\n", s.path.string(), human_size(s.file_size_bytes));
   fmt::print("format       tomorig-session v{}, written by tomorig {} at {}\n", s.format_version,
-             s.software_version.empty() ? "(unknown)" : s.software_version,
-             s.created_utc.empty() ? "(unknown time)" : s.created_utc);
+             s.software_version.empty() ? "(unknown)" : printable(s.software_version),
+             s.created_utc.empty() ? "(unknown time)" : printable(s.created_utc));
   fmt::print("compression  {}\n", to_string(s.compression));
   fmt::print("cameras      {}\n", s.cameras.size());
   for (const auto& c : s.cameras)
@@ -123,7 +124,7 @@ void print_text(const storage::SessionSummary& s) {
   fmt::print("missing      {} frame{} in {} incomplete set{}\n", s.missing_frames, s.missing_frames == 1 ? "" : "s",
              s.incomplete_sets, s.incomplete_sets == 1 ? "" : "s");
   if (s.truth)
-    fmt::print("truth        yes: case {}, flow {}, {} set{} with particles\n", s.truth_case, s.truth_flow,
+    fmt::print("truth        yes: case {}, flow {}, {} set{} with particles\n", printable(s.truth_case), printable(s.truth_flow),
                s.truth_sets, s.truth_sets == 1 ? "" : "s");
   else
     fmt::print("truth        no\n");

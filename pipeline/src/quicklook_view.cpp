@@ -360,7 +360,7 @@ std::string QuickLookView::take(const stream::PreviewMessage& message) {
   }
   if (options_.json) {
     j.erase("images");  // part numbers mean nothing in a line of text
-    return j.dump() + "\n";
+    return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";  // ids from the wire
   }
   return options_.tty ? screen(s, options_.source) : plain_line(s);
 }

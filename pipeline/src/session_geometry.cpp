@@ -199,14 +199,7 @@ namespace {
 
 // A PSF file holds the reconstruction's sigma itself (sigma_px per depth); an optics set-up
 // file holds chi(z), which spray_psf.h turns into sigma. "truth" is neither.
-bool is_psf_file(const std::string& psf) {
-  if (psf == "truth") return false;
-  std::ifstream in(psf);
-  std::string line;
-  while (std::getline(in, line))
-    if (line.find("sigma_px") != std::string::npos) return true;
-  return false;  // a set-up file, or a file the set-up reader refuses with a message
-}
+bool is_psf_file(const std::string& psf) { return psf != "truth" && optics::is_psf_table_file(psf); }
 
 // Each session camera's depth-varying PSF from a PSF file, matched by camera id.
 std::vector<recon::PsfModel> measured_psf(const SessionDescription& session, const std::string& file) {

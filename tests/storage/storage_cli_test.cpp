@@ -78,6 +78,31 @@ TEST_F(CliTest, InspectJsonDescribesTheSession) {
   EXPECT_NE(text.out.find("cam1"), std::string::npos) << text.out;
 }
 
+// A damaged file's free text (here the version attribute, as a flipped bit of the fuzz left it:
+// not UTF-8, and an escape sequence) is shown escaped and never ends `inspect --json` with
+// nlohmann's raw "invalid UTF-8" exception (exit 1 before the fix).
+TEST_F(CliTest, InspectShowsTextThatIsNotUtf8WithoutFailing) {
+  const fs::path path = dir_ / "s.h5";
+  const std::vector<SessionCamera> cameras{test_camera("cam0", 32, 24, PixelFormat::Mono16)};
+  SessionInfo info;
+  info.cameras = cameras;
+  info.software_version = "0.1.0+gc3f80d\xb6\x1b[2J";
+  {
+    SessionWriter writer(path, info, testing::writer_options(Compression::none));
+    writer.append(test_set(cameras, 0));
+    writer.finish();
+  }
+  const RunResult j = run("inspect --json " + quote(path.string()));
+  ASSERT_EQ(j.exit_code, 0) << j.err;
+  const std::string version = nlohmann::json::parse(j.out)["software_version"].get<std::string>();
+  EXPECT_EQ(version, "0.1.0+gc3f80d\xef\xbf\xbd\x1b[2J");  // U+FFFD for the byte that is not UTF-8
+
+  const RunResult text = run("inspect " + quote(path.string()));
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("0.1.0+gc3f80d\\xb6\\x1b[2J"), std::string::npos) << text.out;
+  EXPECT_EQ(text.out.find('\x1b'), std::string::npos) << "an escape sequence reached the terminal";
+}
+
 TEST_F(CliTest, InspectCorruptFileExitsWithBadInput) {
   const fs::path path = dir_ / "s.h5";
   testing::write_test_session(path, {test_camera("cam0", 32, 24, PixelFormat::Mono16)}, 3);

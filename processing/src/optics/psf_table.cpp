@@ -14,6 +14,8 @@
 namespace tomorig::optics {
 namespace {
 
+constexpr const char* kPsfTableKind = "psf-table";
+
 std::string list(const std::vector<double>& v, const char* format) {
   std::string out;
   for (double x : v) out += (out.empty() ? "" : ", ") + fmt::format(fmt::runtime(format), x);
@@ -53,7 +55,7 @@ std::string psf_table_toml(const PsfTable& t, const std::string& header) {
   std::string out;
   std::istringstream lines(header);
   for (std::string line; std::getline(lines, line);) out += "# " + line + "\n";
-  out += fmt::format("voxel_mm = {}\naxis = \"{}\"\n", t.voxel_mm, t.axis);
+  out += fmt::format("kind = \"{}\"\nvoxel_mm = {}\naxis = \"{}\"\n", kPsfTableKind, t.voxel_mm, t.axis);
   for (const PsfTableCamera& c : t.cameras)
     out += fmt::format("\n[[cameras]]\nid = \"{}\"\nz_mm = [{}]\nchi_um = [{}]\nchi_voxel_um = [{}]\nsigma_px = [{}]\n", c.id,
                        list(c.z_mm, "{}"), list(c.chi_um, "{:.2f}"), list(c.chi_voxel_um, "{:.2f}"),
@@ -70,7 +72,9 @@ PsfTable parse_psf_table(std::string_view toml_text, const std::string& source) 
   }
   PsfTable t;
   const detail::TomlReader top(source, "", doc->root());
-  top.only({"voxel_mm", "axis", "cameras"});
+  top.only({"kind", "voxel_mm", "axis", "cameras"});
+  if (top.has("kind") && top.string("kind") != kPsfTableKind)
+    top.fail("kind", top.node("kind"), fmt::format("must be \"{}\" in a PSF file", kPsfTableKind));
   t.voxel_mm = top.number("voxel_mm");
   if (top.has("axis")) t.axis = top.string("axis");
   const config::TomlNode cams = top.node("cameras");
@@ -112,6 +116,22 @@ PsfTable read_psf_table(const std::filesystem::path& path) {
   std::ostringstream text;
   text << in.rdbuf();
   return parse_psf_table(text.str(), path.string());
+}
+
+bool is_psf_table_file(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) return false;
+  std::ostringstream text;
+  text << in.rdbuf();
+  try {
+    const config::TomlDocument doc = config::TomlDocument::parse(text.str(), path.string());
+    const config::TomlNode kind = doc.root()["kind"];
+    if (kind) return kind.as_string() == std::optional<std::string>(kPsfTableKind);
+    const config::TomlNode cams = doc.root()["cameras"];
+    return cams.is_array_of_tables() && cams.size() > 0 && cams[0].contains("sigma_px");
+  } catch (const config::TomlSyntaxError&) {
+    return false;
+  }
 }
 
 }  // namespace tomorig::optics

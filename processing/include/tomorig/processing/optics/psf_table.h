@@ -4,6 +4,7 @@
 // `tomorig process --psf` read it into the reconstruction's depth-varying PSF
 // (reconstruction/psf_model.h: sigma_px per depth). TOML, docs/spray.md:
 //
+//   kind = "psf-table"         # tells it from an optics set-up file (optional on reading)
 //   voxel_mm = 0.0306          # the voxel planes the images were back-projected onto
 //   axis = "y"                 # the spread measured across the board lines along x
 //   [[cameras]]
@@ -43,5 +44,10 @@ std::string psf_table_toml(const PsfTable& table, const std::string& header);
 // Throws bad_input naming the file, key path and line.
 PsfTable parse_psf_table(std::string_view toml_text, const std::string& source);
 PsfTable read_psf_table(const std::filesystem::path& path);
+
+// Whether a file given to `--psf` is a PSF table rather than an optics set-up file: its `kind`
+// says so, or (files written before `kind` existed) its first camera has `sigma_px`. A file
+// that cannot be read or parsed is not one: the set-up reader then names what is wrong.
+bool is_psf_table_file(const std::filesystem::path& path);
 
 }  // namespace tomorig::optics
