@@ -355,26 +355,28 @@ void DirectCorrelator::outer_lags(const OccupiedVoxels& oa, const VolumeView& vb
           }
         }
   };
+  const bool inside = start.x >= 0 && start.y >= 0 && start.z >= 0 && start.x + w.x <= vb.nx &&
+                      start.y + w.y <= vb.ny && start.z + w.z <= vb.nz;
   auto b_at = [&](int i, int j, int k) -> float {
     const int x = start.x + i, y = start.y + j, z = start.z + k;
-    if (x < 0 || y < 0 || z < 0 || x >= vb.nx || y >= vb.ny || z >= vb.nz) return 0.0f;
+    if (!inside && (x < 0 || y < 0 || z < 0 || x >= vb.nx || y >= vb.ny || z >= vb.nz)) return 0.0f;
     return vb.data[vb.linear(x, y, z)];
   };
   // As correlate()'s single lag: P and QA over a's entries, QB over b's, circular in the window.
+  // The weights at the shifted positions come from the circularly padded tables (|lag| <= 2).
   for_entries(oa, [&](int i, int j, int k, float value) {
     const float wa = value * wx_[i] * wy_[j] * wz_[k];
     for (int o = 0; o < count; ++o) {
-      const int ii = wrap(i + lags[o][0], w.x), jj = wrap(j + lags[o][1], w.y), kk = wrap(k + lags[o][2], w.z);
-      const float f = wa * wx_[ii] * wy_[jj] * wz_[kk];
-      ps[o] += f * b_at(ii, jj, kk);
+      const int di = i + lags[o][0], dj = j + lags[o][1], dk = k + lags[o][2];
+      const float f = wa * px_[di + 2] * py_[dj + 2] * pz_[dk + 2];
+      ps[o] += f * b_at(wrap(di, w.x), wrap(dj, w.y), wrap(dk, w.z));
       qas[o] += f;
     }
   });
   for_entries(ob, [&](int i, int j, int k, float value) {
     const float wb = wx_[i] * wy_[j] * wz_[k] * value;
     for (int o = 0; o < count; ++o)
-      qbs[o] += static_cast<double>(wb) * wx_[wrap(i - lags[o][0], w.x)] * wy_[wrap(j - lags[o][1], w.y)] *
-                wz_[wrap(k - lags[o][2], w.z)];
+      qbs[o] += static_cast<double>(wb) * px_[i - lags[o][0] + 2] * py_[j - lags[o][1] + 2] * pz_[k - lags[o][2] + 2];
   });
   for (int o = 0; o < count; ++o) {
     const double k = kx_[lags[o][0] + 2] * ky_[lags[o][1] + 2] * kz_[lags[o][2] + 2];
