@@ -336,23 +336,18 @@ AxisCells axis_cells(int voxels, int factor, double offset, double origin, doubl
 }
 
 // The 4 x 4 x 4 B-spline sum of an interior sample: the 16 rows of 4 coefficients weighted by
-// wz * wy into 4 lanes, then the lanes by wx (two packed multiply-adds per row). One
-// accumulator per plane dk: a single one made the 16 multiply-adds a latency chain (about 64
-// cycles per sample), the largest cost of the deformation in perf.
+// wz * wy into 4 lanes, then the lanes by wx (two packed multiply-adds per row).
 inline float bspline_interior(const float* base, std::size_t sy, std::size_t sz, const float wx[4], const float wy[4],
                               const float wz[4]) {
-  float acc[4][4] = {};
-  for (int dj = 0; dj < 4; ++dj)
-    for (int dk = 0; dk < 4; ++dk) {
+  float acc[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  for (int dk = 0; dk < 4; ++dk)
+    for (int dj = 0; dj < 4; ++dj) {
       const float w = wz[dk] * wy[dj];
       const float* row = base + dk * sz + dj * sy;
 #pragma omp simd
-      for (int l = 0; l < 4; ++l) acc[dk][l] += w * row[l];
+      for (int l = 0; l < 4; ++l) acc[l] += w * row[l];
     }
-  float sum[4];
-#pragma omp simd
-  for (int l = 0; l < 4; ++l) sum[l] = (acc[0][l] + acc[1][l]) + (acc[2][l] + acc[3][l]);
-  return (wx[0] * sum[0] + wx[1] * sum[1]) + (wx[2] * sum[2] + wx[3] * sum[3]);
+  return (wx[0] * acc[0] + wx[1] * acc[1]) + (wx[2] * acc[2] + wx[3] * acc[3]);
 }
 
 // Per-thread buffers of deform_row, sized once per thread.
