@@ -33,7 +33,8 @@ inline int lag_index(int dx, int dy, int dz) { return (dx + 1) + 3 * ((dy + 1) +
 
 }  // namespace
 
-void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, int threads, OccupiedVoxels& o) {
+void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, int threads, OccupiedVoxels& o,
+                   bool faces) {
   o.block = block;
   o.blocks = {ceil_div(v.nx, block.x), ceil_div(v.ny, block.y), ceil_div(v.nz, block.z)};
   const std::size_t block_count = static_cast<std::size_t>(o.blocks.x) * o.blocks.y * o.blocks.z;
@@ -99,23 +100,33 @@ void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, in
       default: return e.z % block.z == block.z - 1;
     }
   };
+  if (!faces) {
+    for (auto& fo : o.face_offsets) fo.clear();
+    for (auto& fe : o.face_entries) fe.clear();
+    return;
+  }
+  for (auto& fo : o.face_offsets) fo.assign(block_count + 1, 0);
+  // (One parallel loop to count and one to fill all six faces: a parallel region per face cost
+  // more in thread wake-ups than the work on a loaded machine.)
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (long long b = 0; b < static_cast<long long>(block_count); ++b) {
+    std::size_t c[6] = {};
+    for (std::size_t e = o.offsets[b]; e < o.offsets[b + 1]; ++e)
+      for (int f = 0; f < 6; ++f) c[f] += on_face(o.entries[e], f);
+    for (int f = 0; f < 6; ++f) o.face_offsets[f][b + 1] = c[f];
+  }
   for (int f = 0; f < 6; ++f) {
     std::vector<std::size_t>& fo = o.face_offsets[f];
-    fo.assign(block_count + 1, 0);
-#pragma omp parallel for num_threads(threads) schedule(static)
-    for (long long b = 0; b < static_cast<long long>(block_count); ++b) {
-      std::size_t c = 0;
-      for (std::size_t e = o.offsets[b]; e < o.offsets[b + 1]; ++e) c += on_face(o.entries[e], f);
-      fo[b + 1] = c;
-    }
     for (std::size_t b = 0; b < block_count; ++b) fo[b + 1] += fo[b];
     o.face_entries[f].resize(fo[block_count]);
+  }
 #pragma omp parallel for num_threads(threads) schedule(static)
-    for (long long b = 0; b < static_cast<long long>(block_count); ++b) {
-      std::size_t out = fo[b];
-      for (std::size_t e = o.offsets[b]; e < o.offsets[b + 1]; ++e)
-        if (on_face(o.entries[e], f)) o.face_entries[f][out++] = o.entries[e];
-    }
+  for (long long b = 0; b < static_cast<long long>(block_count); ++b) {
+    std::size_t out[6];
+    for (int f = 0; f < 6; ++f) out[f] = o.face_offsets[f][b];
+    for (std::size_t e = o.offsets[b]; e < o.offsets[b + 1]; ++e)
+      for (int f = 0; f < 6; ++f)
+        if (on_face(o.entries[e], f)) o.face_entries[f][out[f]++] = o.entries[e];
   }
 }
 

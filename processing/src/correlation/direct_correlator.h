@@ -44,8 +44,10 @@ struct OccupiedVoxels {
   std::vector<Entry> face_entries[6];
   double occupied_fraction = 0;       // entries / voxels
 };
-// Fills `out`, reusing its memory (one list per volume for a whole correlation).
-void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, int threads, OccupiedVoxels& out);
+// Fills `out`, reusing its memory (one list per volume for a whole correlation); the face lists
+// only with `faces` (the wrapped lags read them from volume a's lists alone).
+void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, int threads, OccupiedVoxels& out,
+                   bool faces);
 
 // The fraction of a volume's largest magnitude below which a voxel counts as empty.
 inline constexpr float kOccupiedThreshold = 1e-3f;
