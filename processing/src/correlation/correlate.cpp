@@ -187,10 +187,13 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
     bool direct = false;
     // (Entries store 16-bit coordinates: larger volumes keep the FFT.)
     const bool listable = va.nx <= 65535 && va.ny <= 65535 && va.nz <= 65535;
+    double seconds_listing = 0;
     if (deform && listable && pass.method != CorrelationMethod::fft && g.window.x >= 8 && g.window.y >= 8 &&
         g.window.z >= 8) {
-      detail::list_occupied(va, g.step, detail::kOccupiedThreshold, threads, level.occupied_a);
-      detail::list_occupied(vb, g.step, detail::kOccupiedThreshold, threads, level.occupied_b);
+      const auto start_listing = std::chrono::steady_clock::now();
+      detail::list_occupied(va, g.step, detail::kOccupiedThreshold, threads, level.occupied_a, true);
+      detail::list_occupied(vb, g.step, detail::kOccupiedThreshold, threads, level.occupied_b, false);
+      seconds_listing = seconds_since(start_listing);
       pr.occupied_fraction = 0.5 * (occupied_a.occupied_fraction + occupied_b.occupied_fraction);
       direct = use_direct(pass, g.window, deform, pr.occupied_fraction);
     }
@@ -256,8 +259,9 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
     }
     pr.fft_fallbacks = fft_fallbacks;
     pr.seconds_windows = seconds_since(start_windows);
-    pr.thread_seconds_load = load;
-    // (The shared lag sums ran on all threads: their wall time times the threads.)
+    // (The occupied-voxel lists and the shared lag sums ran on all threads: their wall time
+    // times the threads.)
+    pr.thread_seconds_load = load + seconds_listing * threads;
     pr.thread_seconds_correlation = correlation + seconds_lag_sums * threads;
     pr.thread_seconds_peak = peak_fit;
     pr.empty_windows = empty;

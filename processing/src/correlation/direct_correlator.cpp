@@ -33,7 +33,8 @@ inline int lag_index(int dx, int dy, int dz) { return (dx + 1) + 3 * ((dy + 1) +
 
 }  // namespace
 
-void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, int threads, OccupiedVoxels& o) {
+void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, int threads, OccupiedVoxels& o,
+                   bool faces) {
   o.block = block;
   o.blocks = {ceil_div(v.nx, block.x), ceil_div(v.ny, block.y), ceil_div(v.nz, block.z)};
   const std::size_t block_count = static_cast<std::size_t>(o.blocks.x) * o.blocks.y * o.blocks.z;
@@ -86,6 +87,47 @@ void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, in
   for (std::size_t b = block_count; b > 0; --b) counts[b] = counts[b - 1];
   counts[0] = 0;
   o.occupied_fraction = voxels ? static_cast<double>(o.entries.size()) / static_cast<double>(voxels) : 0.0;
+
+  // Each block's entries on its six faces, in the block's scan order (counted, then filled, per
+  // block: no thread-count dependence).
+  auto on_face = [&](const OccupiedVoxels::Entry& e, int f) {
+    switch (f) {
+      case 0: return e.x % block.x == 0;
+      case 1: return e.x % block.x == block.x - 1;
+      case 2: return e.y % block.y == 0;
+      case 3: return e.y % block.y == block.y - 1;
+      case 4: return e.z % block.z == 0;
+      default: return e.z % block.z == block.z - 1;
+    }
+  };
+  if (!faces) {
+    for (auto& fo : o.face_offsets) fo.clear();
+    for (auto& fe : o.face_entries) fe.clear();
+    return;
+  }
+  for (auto& fo : o.face_offsets) fo.assign(block_count + 1, 0);
+  // (One parallel loop to count and one to fill all six faces: a parallel region per face cost
+  // more in thread wake-ups than the work on a loaded machine.)
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (long long b = 0; b < static_cast<long long>(block_count); ++b) {
+    std::size_t c[6] = {};
+    for (std::size_t e = o.offsets[b]; e < o.offsets[b + 1]; ++e)
+      for (int f = 0; f < 6; ++f) c[f] += on_face(o.entries[e], f);
+    for (int f = 0; f < 6; ++f) o.face_offsets[f][b + 1] = c[f];
+  }
+  for (int f = 0; f < 6; ++f) {
+    std::vector<std::size_t>& fo = o.face_offsets[f];
+    for (std::size_t b = 0; b < block_count; ++b) fo[b + 1] += fo[b];
+    o.face_entries[f].resize(fo[block_count]);
+  }
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (long long b = 0; b < static_cast<long long>(block_count); ++b) {
+    std::size_t out[6];
+    for (int f = 0; f < 6; ++f) out[f] = o.face_offsets[f][b];
+    for (std::size_t e = o.offsets[b]; e < o.offsets[b + 1]; ++e)
+      for (int f = 0; f < 6; ++f)
+        if (on_face(o.entries[e], f)) o.face_entries[f][out[f]++] = o.entries[e];
+  }
 }
 
 DirectCorrelator::DirectCorrelator(Int3 window, WindowWeighting weighting, double gaussian_sigma)
@@ -136,64 +178,64 @@ WindowPeak DirectCorrelator::correlate_from_sums(const float* sums, const Occupi
   // The shell: entries with a coordinate at 0 or W - 1, whose lags outward wrap around the
   // window as the FFT's (the contraction left those pairs out of P). Blocks that hold no shell
   // plane are skipped.
-  const std::size_t sy = static_cast<std::size_t>(vb.nx), sz = sy * static_cast<std::size_t>(vb.ny);
   const bool inside = start.x >= 0 && start.y >= 0 && start.z >= 0 && start.x + w.x <= vb.nx &&
                       start.y + w.y <= vb.ny && start.z + w.z <= vb.nz;
   const int bx0 = std::max(0, start.x) / oa.block.x, bx1 = std::min(oa.blocks.x - 1, (start.x + w.x - 1) / oa.block.x);
   const int by0 = std::max(0, start.y) / oa.block.y, by1 = std::min(oa.blocks.y - 1, (start.y + w.y - 1) / oa.block.y);
   const int bz0 = std::max(0, start.z) / oa.block.z, bz1 = std::min(oa.blocks.z - 1, (start.z + w.z - 1) / oa.block.z);
-  auto holds_shell = [](int b, int size, int first, int last) {  // block b holds plane first or last
-    const int lo = b * size, hi = lo + size;
-    return (first >= lo && first < hi) || (last >= lo && last < hi);
-  };
   alignas(16) float p4[9][4] = {};  // per (dy, dz) row, x lags as 4 float lanes (the 4th unused)
-  for (int bz = bz0; bz <= bz1; ++bz) {
-    const bool shell_z = holds_shell(bz, oa.block.z, start.z, start.z + w.z - 1);
-    for (int by = by0; by <= by1; ++by) {
-      const bool shell_y = holds_shell(by, oa.block.y, start.y, start.y + w.y - 1);
-      for (int bx = bx0; bx <= bx1; ++bx) {
-        if (!shell_z && !shell_y && !holds_shell(bx, oa.block.x, start.x, start.x + w.x - 1)) continue;
-        const std::size_t b = bx + static_cast<std::size_t>(oa.blocks.x) * (by + static_cast<std::size_t>(oa.blocks.y) * bz);
-        for (std::size_t e = oa.offsets[b]; e < oa.offsets[b + 1]; ++e) {
-          const OccupiedVoxels::Entry& v = oa.entries[e];
-          const int i = v.x - start.x, j = v.y - start.y, k = v.z - start.z;
-          // (Unsigned: one test each for below 0 and beyond the window.)
-          if (static_cast<unsigned>(i) >= static_cast<unsigned>(w.x) ||
-              static_cast<unsigned>(j) >= static_cast<unsigned>(w.y) ||
-              static_cast<unsigned>(k) >= static_cast<unsigned>(w.z))
-            continue;
-          if (static_cast<unsigned>(i - 1) < static_cast<unsigned>(w.x - 2) &&
-              static_cast<unsigned>(j - 1) < static_cast<unsigned>(w.y - 2) &&
-              static_cast<unsigned>(k - 1) < static_cast<unsigned>(w.z - 2))
-            continue;  // interior: no lag wraps, all in the contraction
-          const float wa = v.value * wx_[i] * wy_[j] * wz_[k];
-          alignas(16) float px[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-          float py[3], pz[3];
-          int xs[3], ys[3], zs[3];
-          // Per axis, which lags wrap: only (voxel, lag) pairs with a wrap are left here.
-          const bool wrap_x[3] = {i == 0, false, i == w.x - 1}, wrap_y[3] = {j == 0, false, j == w.y - 1},
-                     wrap_z[3] = {k == 0, false, k == w.z - 1};
-          for (int d = -1; d <= 1; ++d) {
-            px[d + 1] = px_[i + d + 2];
-            py[d + 1] = py_[j + d + 2];
-            pz[d + 1] = pz_[k + d + 2];
-            xs[d + 1] = start.x + wrap(i + d, w.x);
-            ys[d + 1] = start.y + wrap(j + d, w.y);
-            zs[d + 1] = start.z + wrap(k + d, w.z);
-          }
-          for (int dz = 0; dz < 3; ++dz)
-            for (int dy = 0; dy < 3; ++dy) {
-              const bool row_wraps = wrap_z[dz] || wrap_y[dy];
-              if (!row_wraps && !wrap_x[0] && !wrap_x[2]) continue;
-              const float f = wa * pz[dz] * py[dy];
-              // (Inside: every wrapped lag is inside the volume, no bounds tests.)
-              const bool row_in = inside || (zs[dz] >= 0 && zs[dz] < vb.nz && ys[dy] >= 0 && ys[dy] < vb.ny);
-              const float* row = vb.data + (row_in ? static_cast<std::size_t>(zs[dz]) * sz + static_cast<std::size_t>(ys[dy]) * sy : 0);
-              float* pr = p4[dy + 3 * dz];
-              for (int dx = 0; dx < 3; ++dx)
-                if (row_wraps || wrap_x[dx])
-                  pr[dx] += f * px[dx] * (row_in && (inside || (xs[dx] >= 0 && xs[dx] < vb.nx)) ? row[xs[dx]] : 0.0f);
+  const bool on_borders = inside && w.x % oa.block.x == 0 && w.y % oa.block.y == 0 && w.z % oa.block.z == 0 &&
+                          start.x % oa.block.x == 0 && start.y % oa.block.y == 0 && start.z % oa.block.z == 0;
+  if (on_borders) {
+    // The window covers whole blocks: its shell is the low face of its first blocks and the
+    // high face of its last along each axis. Each entry is taken from the first of the six
+    // faces (x low, x high, y low, y high, z low, z high) it lies on.
+    for (int f = 0; f < 6; ++f) {
+      const int axis = f / 2;
+      const bool high = f % 2;
+      int lo[3] = {bx0, by0, bz0}, hi[3] = {bx1, by1, bz1};
+      lo[axis] = hi[axis] = high ? hi[axis] : lo[axis];
+      const std::vector<std::size_t>& fo = oa.face_offsets[f];
+      const OccupiedVoxels::Entry* fe = oa.face_entries[f].data();
+      for (int bz = lo[2]; bz <= hi[2]; ++bz)
+        for (int by = lo[1]; by <= hi[1]; ++by)
+          for (int bx = lo[0]; bx <= hi[0]; ++bx) {
+            const std::size_t b = bx + static_cast<std::size_t>(oa.blocks.x) * (by + static_cast<std::size_t>(oa.blocks.y) * bz);
+            for (std::size_t e = fo[b]; e < fo[b + 1]; ++e) {
+              const OccupiedVoxels::Entry& v = fe[e];
+              const int i = v.x - start.x, j = v.y - start.y, k = v.z - start.z;
+              if (axis >= 1 && (i == 0 || i == w.x - 1)) continue;  // taken from an x face
+              if (axis == 2 && (j == 0 || j == w.y - 1)) continue;  // taken from a y face
+              add_shell_entry(v, i, j, k, start, vb, inside, p4);
             }
+          }
+    }
+  } else {
+    auto holds_shell = [](int b, int size, int first, int last) {  // block b holds plane first or last
+      const int lo = b * size, hi = lo + size;
+      return (first >= lo && first < hi) || (last >= lo && last < hi);
+    };
+    for (int bz = bz0; bz <= bz1; ++bz) {
+      const bool shell_z = holds_shell(bz, oa.block.z, start.z, start.z + w.z - 1);
+      for (int by = by0; by <= by1; ++by) {
+        const bool shell_y = holds_shell(by, oa.block.y, start.y, start.y + w.y - 1);
+        for (int bx = bx0; bx <= bx1; ++bx) {
+          if (!shell_z && !shell_y && !holds_shell(bx, oa.block.x, start.x, start.x + w.x - 1)) continue;
+          const std::size_t b = bx + static_cast<std::size_t>(oa.blocks.x) * (by + static_cast<std::size_t>(oa.blocks.y) * bz);
+          for (std::size_t e = oa.offsets[b]; e < oa.offsets[b + 1]; ++e) {
+            const OccupiedVoxels::Entry& v = oa.entries[e];
+            const int i = v.x - start.x, j = v.y - start.y, k = v.z - start.z;
+            // (Unsigned: one test each for below 0 and beyond the window.)
+            if (static_cast<unsigned>(i) >= static_cast<unsigned>(w.x) ||
+                static_cast<unsigned>(j) >= static_cast<unsigned>(w.y) ||
+                static_cast<unsigned>(k) >= static_cast<unsigned>(w.z))
+              continue;
+            if (static_cast<unsigned>(i - 1) < static_cast<unsigned>(w.x - 2) &&
+                static_cast<unsigned>(j - 1) < static_cast<unsigned>(w.y - 2) &&
+                static_cast<unsigned>(k - 1) < static_cast<unsigned>(w.z - 2))
+              continue;  // interior: no lag wraps, all in the contraction
+            add_shell_entry(v, i, j, k, start, vb, inside, p4);
+          }
         }
       }
     }
@@ -267,6 +309,40 @@ WindowPeak DirectCorrelator::correlate_from_sums(const float* sums, const Occupi
   return result;
 }
 
+void DirectCorrelator::add_shell_entry(const OccupiedVoxels::Entry& v, int i, int j, int k, Int3 start,
+                                       const VolumeView& vb, bool inside, float (*p4)[4]) const {
+  const Int3 w = window_;
+  const std::size_t sy = static_cast<std::size_t>(vb.nx), sz = sy * static_cast<std::size_t>(vb.ny);
+  const float wa = v.value * wx_[i] * wy_[j] * wz_[k];
+  alignas(16) float px[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  float py[3], pz[3];
+  int xs[3], ys[3], zs[3];
+  // Per axis, which lags wrap: only (voxel, lag) pairs with a wrap are left here.
+  const bool wrap_x[3] = {i == 0, false, i == w.x - 1}, wrap_y[3] = {j == 0, false, j == w.y - 1},
+             wrap_z[3] = {k == 0, false, k == w.z - 1};
+  for (int d = -1; d <= 1; ++d) {
+    px[d + 1] = px_[i + d + 2];
+    py[d + 1] = py_[j + d + 2];
+    pz[d + 1] = pz_[k + d + 2];
+    xs[d + 1] = start.x + wrap(i + d, w.x);
+    ys[d + 1] = start.y + wrap(j + d, w.y);
+    zs[d + 1] = start.z + wrap(k + d, w.z);
+  }
+  for (int dz = 0; dz < 3; ++dz)
+    for (int dy = 0; dy < 3; ++dy) {
+      const bool row_wraps = wrap_z[dz] || wrap_y[dy];
+      if (!row_wraps && !wrap_x[0] && !wrap_x[2]) continue;
+      const float f = wa * pz[dz] * py[dy];
+      // (Inside: every wrapped lag is inside the volume, no bounds tests.)
+      const bool row_in = inside || (zs[dz] >= 0 && zs[dz] < vb.nz && ys[dy] >= 0 && ys[dy] < vb.ny);
+      const float* row = vb.data + (row_in ? static_cast<std::size_t>(zs[dz]) * sz + static_cast<std::size_t>(ys[dy]) * sy : 0);
+      float* pr = p4[dy + 3 * dz];
+      for (int dx = 0; dx < 3; ++dx)
+        if (row_wraps || wrap_x[dx])
+          pr[dx] += f * px[dx] * (row_in && (inside || (xs[dx] >= 0 && xs[dx] < vb.nx)) ? row[xs[dx]] : 0.0f);
+    }
+}
+
 void DirectCorrelator::outer_lags(const OccupiedVoxels& oa, const VolumeView& vb, const OccupiedVoxels& ob, Int3 start,
                                   const int lags[][3], int count, double mean_a, double mean_b, double* out) const {
   const Int3 w = window_;
@@ -290,26 +366,28 @@ void DirectCorrelator::outer_lags(const OccupiedVoxels& oa, const VolumeView& vb
           }
         }
   };
+  const bool inside = start.x >= 0 && start.y >= 0 && start.z >= 0 && start.x + w.x <= vb.nx &&
+                      start.y + w.y <= vb.ny && start.z + w.z <= vb.nz;
   auto b_at = [&](int i, int j, int k) -> float {
     const int x = start.x + i, y = start.y + j, z = start.z + k;
-    if (x < 0 || y < 0 || z < 0 || x >= vb.nx || y >= vb.ny || z >= vb.nz) return 0.0f;
+    if (!inside && (x < 0 || y < 0 || z < 0 || x >= vb.nx || y >= vb.ny || z >= vb.nz)) return 0.0f;
     return vb.data[vb.linear(x, y, z)];
   };
   // As correlate()'s single lag: P and QA over a's entries, QB over b's, circular in the window.
+  // The weights at the shifted positions come from the circularly padded tables (|lag| <= 2).
   for_entries(oa, [&](int i, int j, int k, float value) {
     const float wa = value * wx_[i] * wy_[j] * wz_[k];
     for (int o = 0; o < count; ++o) {
-      const int ii = wrap(i + lags[o][0], w.x), jj = wrap(j + lags[o][1], w.y), kk = wrap(k + lags[o][2], w.z);
-      const float f = wa * wx_[ii] * wy_[jj] * wz_[kk];
-      ps[o] += f * b_at(ii, jj, kk);
+      const int di = i + lags[o][0], dj = j + lags[o][1], dk = k + lags[o][2];
+      const float f = wa * px_[di + 2] * py_[dj + 2] * pz_[dk + 2];
+      ps[o] += f * b_at(wrap(di, w.x), wrap(dj, w.y), wrap(dk, w.z));
       qas[o] += f;
     }
   });
   for_entries(ob, [&](int i, int j, int k, float value) {
     const float wb = wx_[i] * wy_[j] * wz_[k] * value;
     for (int o = 0; o < count; ++o)
-      qbs[o] += static_cast<double>(wb) * wx_[wrap(i - lags[o][0], w.x)] * wy_[wrap(j - lags[o][1], w.y)] *
-                wz_[wrap(k - lags[o][2], w.z)];
+      qbs[o] += static_cast<double>(wb) * px_[i - lags[o][0] + 2] * py_[j - lags[o][1] + 2] * pz_[k - lags[o][2] + 2];
   });
   for (int o = 0; o < count; ++o) {
     const double k = kx_[lags[o][0] + 2] * ky_[lags[o][1] + 2] * kz_[lags[o][2] + 2];

@@ -36,10 +36,18 @@ struct OccupiedVoxels {
   // row_entries[row_offsets[r] .. row_offsets[r + 1]).
   std::vector<std::size_t> row_offsets;
   std::vector<RowEntry> row_entries;
+  // Per block, its entries on each of its six faces (x = first, x = last, y = first, ... of
+  // the block; face f of block b is face_entries[f][face_offsets[f][b] .. face_offsets[f][b + 1])):
+  // where windows start and end on block borders, a window's shell is the union of its
+  // border blocks' faces, so its wrapped lags visit only those entries.
+  std::vector<std::size_t> face_offsets[6];
+  std::vector<Entry> face_entries[6];
   double occupied_fraction = 0;       // entries / voxels
 };
-// Fills `out`, reusing its memory (one list per volume for a whole correlation).
-void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, int threads, OccupiedVoxels& out);
+// Fills `out`, reusing its memory (one list per volume for a whole correlation); the face lists
+// only with `faces` (the wrapped lags read them from volume a's lists alone).
+void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, int threads, OccupiedVoxels& out,
+                   bool faces);
 
 // The fraction of a volume's largest magnitude below which a voxel counts as empty.
 inline constexpr float kOccupiedThreshold = 1e-3f;
@@ -73,6 +81,10 @@ class DirectCorrelator {
   double weight_energy_ = 0;             // sum of w^2 over the window
   // Circular autocorrelation of the weights per axis, K(d) for d = -2..2 at index d + 2.
   double kx_[5], ky_[5], kz_[5];
+
+  // Adds the wrapped lag products of one shell entry (window coordinates i, j, k) into p4.
+  void add_shell_entry(const OccupiedVoxels::Entry& v, int i, int j, int k, Int3 start, const VolumeView& vb,
+                       bool inside, float (*p4)[4]) const;
 
   // R(s) of Eq. 2.16 at `count` (<= 3) lags with one component +-2, circular in the window,
   // over every entry of the window.

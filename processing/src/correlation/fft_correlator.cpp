@@ -11,6 +11,7 @@
 #include <tuple>
 
 #include "tomorig/core/error.h"
+#include "correlation/window_kernels.h"
 #include "tomorig/processing/correlation/peak_fit.h"
 
 namespace tomorig::piv::detail {
@@ -175,11 +176,7 @@ WindowPeak FftCorrelator::correlate(const VolumeView& va, Int3 start_a, const Vo
   fftwf_execute_dft_r2c(plans.forward, s.a.get(), fa);
   fftwf_execute_dft_r2c(plans.forward, s.b.get(), fb);
   // conj(A) * B: the correlation peaks at the displacement of b relative to a.
-  for (std::size_t m = 0; m < complex_count_; ++m) {
-    const float ar = fa[m][0], ai = fa[m][1], br = fb[m][0], bi = fb[m][1];
-    fa[m][0] = ar * br + ai * bi;
-    fa[m][1] = ar * bi - ai * br;
-  }
+  spectrum_product(s.spectrum_a.get(), s.spectrum_b.get(), complex_count_);
   float* plane = s.a.get();
   fftwf_execute_dft_c2r(plans.backward, fa, plane);
   const auto t2 = Clock::now();
@@ -190,12 +187,10 @@ WindowPeak FftCorrelator::correlate(const VolumeView& va, Int3 start_a, const Vo
     ~PeakClock() { sum += seconds_between(start, Clock::now()); }
   } peak_clock{t2, s.seconds.peak};
 
-  // The first highest value: a vectorised maximum, then its first position.
-  float best_value = plane[0];
-#pragma omp simd reduction(max : best_value)
-  for (std::size_t m = 1; m < real_count_; ++m) best_value = std::max(best_value, plane[m]);
-  const std::size_t best = static_cast<std::size_t>(std::find(plane, plane + real_count_, best_value) - plane);
+  // The first highest value.
+  const std::size_t best = first_maximum(plane, real_count_);
   if (best >= real_count_) return result;  // NaN in the plane: no peak
+  const float best_value = plane[best];
   // FFTW's inverse is unnormalised (factor N); Eq. 2.16 divides by the standard deviations.
   const double scale = 1.0 / (static_cast<double>(real_count_) * std::sqrt(energy_a * energy_b));
   const int ix = static_cast<int>(best % window_.x);

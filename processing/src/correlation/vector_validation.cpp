@@ -1,5 +1,7 @@
 #include "tomorig/processing/correlation/vector_validation.h"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -74,6 +76,10 @@ ValidationCounts validate_field(VectorField& field, const CorrelationOptions& op
   }
   if (options.median_test.enabled) {
     std::vector<std::uint8_t> fails(count, 0);
+    // Each node is judged against the measured flags alone and writes only its own flag, so
+    // the planes can be judged in parallel with the same outcome.
+    const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
     for (int k = 0; k < field.nz; ++k)
       for (int j = 0; j < field.ny; ++j)
         for (int i = 0; i < field.nx; ++i) {

@@ -31,7 +31,7 @@ struct PassReport {
   double seconds_validation = 0.0;   // mask, validation, predictor for the next pass
   // The window loop split by stage, in thread-seconds summed over the threads (each stage's
   // share of seconds_windows is its share of these).
-  double thread_seconds_load = 0.0;         // copying windows, means, energies, weights
+  double thread_seconds_load = 0.0;         // copying windows, means, energies, weights; or listing the occupied voxels (wall x threads)
   double thread_seconds_correlation = 0.0;  // FFTs and spectrum product, or direct sums
   double thread_seconds_peak = 0.0;         // highest value and sub-voxel fit
 };
