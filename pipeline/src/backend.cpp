@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include <fmt/core.h>
+#include <sys/resource.h>
 
 #include "backend_parts.h"
 #include "cluster_backend.h"
@@ -27,6 +28,22 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
+
+double seconds_between(Clock::time_point from, Clock::time_point to) {
+  return std::chrono::duration<double>(to - from).count();
+}
+
+// CPU time (user, system) of the whole process and its minor page faults so far.
+struct ProcessUsage {
+  double user = 0.0, system = 0.0;
+  long minor_faults = 0;
+};
+ProcessUsage process_usage() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  const auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); };
+  return {seconds(u.ru_utime), seconds(u.ru_stime), u.ru_minflt};
+}
 
 // The results file must match this run: same session first (the clearer message), then the grid.
 void check_existing_results(const fs::path& out, const std::string& identity, const nlohmann::json& grid) {
@@ -108,6 +125,15 @@ std::string BackendStep::text() const {
   return {};
 }
 
+BackendStageSeconds& BackendStageSeconds::operator+=(const BackendStageSeconds& o) {
+  load += o.load;
+  preprocess += o.preprocess;
+  reconstruction += o.reconstruction;
+  correlation += o.correlation;
+  write += o.write;
+  return *this;
+}
+
 nlohmann::json BackendReport::to_json() const {
   const Vec3d& m = mean_displacement_voxel;
   const Vec3d& s = spatial_std_displacement_voxel;
@@ -135,6 +161,14 @@ nlohmann::json BackendReport::to_json() const {
                       {"busy_seconds", r.busy_seconds},
                       {"sets_per_second", seconds > 0 ? r.sets / seconds : 0.0}});
     json["mpi_ranks"] = list;
+  } else {
+    const BackendStageSeconds& t = stage_seconds;
+    json["stage_seconds"] = {{"load", t.load}, {"preprocess", t.preprocess}, {"reconstruction", t.reconstruction},
+                             {"correlation", t.correlation}, {"write", t.write}};
+    json["cpu_seconds"] = cpu_user_seconds + cpu_system_seconds;
+    json["cpu_user_seconds"] = cpu_user_seconds;
+    json["cpu_system_seconds"] = cpu_system_seconds;
+    json["minor_page_faults"] = minor_page_faults;
   }
   return json;
 }
@@ -174,7 +208,11 @@ ReconstructedSet BackendInputs::reconstruct(std::uint64_t index, const std::func
   const auto set_started = Clock::now();
   if (step) step({.set = index, .kind = BackendStep::Kind::preprocessing});
   FrameSet set = session.read_set(index);
+  const auto loaded = Clock::now();
   preprocessor_->apply(set);
+  const auto preprocessed = Clock::now();
+  stage_seconds.load += seconds_between(set_started, loaded);
+  stage_seconds.preprocess += seconds_between(loaded, preprocessed);
   std::function<void(char)> exposure_started;
   if (step)
     exposure_started = [&](char e) {
@@ -187,6 +225,7 @@ ReconstructedSet BackendInputs::reconstruct(std::uint64_t index, const std::func
     };
   ReconstructedSet pair = processor.reconstruct(set, index, dt[index], exposure_started);
   if (step) processor.set_iteration_progress({});
+  stage_seconds.reconstruction += seconds_between(preprocessed, Clock::now());
   pair.started = set_started;  // a set's time includes reading and preprocessing it
   return pair;
 }
@@ -242,6 +281,7 @@ BackendReport run_backend(const fs::path& session_path, const BackendOptions& op
     return run_backend_on_mpi(session_path, options, hooks);
   options.validate();
   const auto started = Clock::now();
+  const ProcessUsage usage_at_start = process_usage();
   const auto notice = [&](const std::string& text) {
     if (hooks.notice) hooks.notice(text);
   };
@@ -277,8 +317,12 @@ BackendReport run_backend(const fs::path& session_path, const BackendOptions& op
     if (stop_requested()) return false;
     if (hooks.step) hooks.step({.set = r.index, .kind = BackendStep::Kind::correlating});
     piv::CorrelationReport corr_report;
+    const auto correlating = Clock::now();
     const storage::SetResult result = inputs.processor.correlate(r, corr_report);
+    const auto correlated = Clock::now();
     results.add(result);
+    report.stage_seconds.correlation += seconds_between(correlating, correlated);
+    report.stage_seconds.write += seconds_between(correlated, Clock::now());
     valid_sum += corr_report.valid_fraction();
     ++report.sets_processed;
     if (hooks.set_done)
@@ -300,13 +344,21 @@ BackendReport run_backend(const fs::path& session_path, const BackendOptions& op
 
   report.sets_in_file = results.set_count();
   report.mean_valid_fraction = report.sets_processed > 0 ? valid_sum / report.sets_processed : 0.0;
+  report.stage_seconds += inputs.stage_seconds;  // the producer has finished
+  const auto finish = [&] {
+    report.seconds = seconds_between(started, Clock::now());
+    const ProcessUsage usage = process_usage();
+    report.cpu_user_seconds = usage.user - usage_at_start.user;
+    report.cpu_system_seconds = usage.system - usage_at_start.system;
+    report.minor_page_faults = usage.minor_faults - usage_at_start.minor_faults;
+  };
   if (stop_requested()) {
     report.interrupted = true;  // the file is valid: every finished set is in it
-    report.seconds = std::chrono::duration<double>(Clock::now() - started).count();
+    finish();
     return report;
   }
   finish_results(results, options, report);
-  report.seconds = std::chrono::duration<double>(Clock::now() - started).count();
+  finish();
   return report;
 }
 

@@ -36,6 +36,9 @@ class BackendInputs {
   const PairProcessor processor;
   const std::uint64_t sets_asked;  // max_sets applied
   const std::vector<std::int64_t> dt;
+  // Load, preprocess and reconstruction seconds of the sets reconstructed so far (by the thread
+  // that calls reconstruct()).
+  BackendStageSeconds stage_seconds;
 
  private:
   std::optional<SessionPreprocessor> preprocessor_;

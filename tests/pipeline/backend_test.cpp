@@ -58,6 +58,22 @@ TEST_F(Backend, OverlappedAndSequentialRunsWriteTheSameField) {
   EXPECT_EQ(a.sets_in_file, 2u);
   EXPECT_EQ(a.sets_processed, 2u);
   EXPECT_GT(a.mean_valid_fraction, 0.3);  // a sanity check: accuracy against the flow is process_cli_test's
+  // Where the time went: every stage of every set counted once, so one set at a time the stages
+  // add up to no more than the run; the run used CPU and the JSON carries it all.
+  const pipeline::BackendStageSeconds& t = a.stage_seconds;
+  EXPECT_GT(t.load, 0.0);
+  EXPECT_GT(t.reconstruction, 0.0);
+  EXPECT_GT(t.correlation, 0.0);
+  EXPECT_GT(t.write, 0.0);
+  EXPECT_GE(t.preprocess, 0.0);
+  EXPECT_LT(t.preprocess, 0.01) << "no chain: nothing to preprocess";
+  EXPECT_LE(t.load + t.preprocess + t.reconstruction + t.correlation + t.write, a.seconds);
+  EXPECT_GT(a.cpu_user_seconds, 0.0);
+  EXPECT_GE(a.minor_page_faults, 0);
+  const nlohmann::json json = a.to_json();
+  EXPECT_DOUBLE_EQ(json.at("stage_seconds").at("correlation").get<double>(), t.correlation);
+  EXPECT_DOUBLE_EQ(json.at("cpu_seconds").get<double>(), a.cpu_user_seconds + a.cpu_system_seconds);
+  EXPECT_TRUE(json.contains("minor_page_faults"));
 
   pipeline::BackendOptions overlapped = options(*dir_ / "overlapped.h5");
   overlapped.png = *dir_ / "mean-slice.png";  // the mean field's middle z-slice, axes in mm

@@ -16,15 +16,6 @@
 #include "tomorig/core/error.h"
 
 namespace tomorig::recon::detail {
-namespace {
-
-struct SliceResult {
-  std::vector<std::uint32_t> index;
-  std::vector<float> value;
-};
-
-}  // namespace
-
 ActiveSet run_mlos(const PreparedInput& in, const GridProjector& projector, const MlosSettings& settings) {
   const VoxelGrid& g = in.grid;
   // Thresholded images, reach masks, cameras ordered most selective first (support_scan.h).
@@ -38,7 +29,14 @@ ActiveSet run_mlos(const PreparedInput& in, const GridProjector& projector, cons
   std::atomic<std::size_t> active{0};
   std::atomic<bool> over_budget{false};
 
-  std::vector<SliceResult> slices(static_cast<std::size_t>(g.nz));
+  MlosBuffers own;
+  MlosBuffers& buffers = settings.buffers ? *settings.buffers : own;
+  std::vector<MlosBuffers::Slice>& slices = buffers.slices;
+  slices.resize(static_cast<std::size_t>(g.nz));
+  for (MlosBuffers::Slice& s : slices) {  // emptied, their capacity (and its touched pages) kept
+    s.index.clear();
+    s.value.clear();
+  }
   // Blocks of kSlabSlices z-slices, row by row across the block: the same grid row j of
   // neighbouring slices projects to the same few image rows, so their reads hit the cache.
   const int blocks = (g.nz + kSlabSlices - 1) / kSlabSlices;
@@ -52,7 +50,7 @@ ActiveSet run_mlos(const PreparedInput& in, const GridProjector& projector, cons
       std::size_t found = 0;
       for (int j = 0; j < g.ny; ++j)
         for (int k = k0; k < k1; ++k) {
-          SliceResult& out = slices[static_cast<std::size_t>(k)];
+          MlosBuffers::Slice& out = slices[static_cast<std::size_t>(k)];
           const int count = scanner.scan(j, k, row);
           const std::uint32_t base = static_cast<std::uint32_t>(g.linear(0, j, k));
           for (int n = 0; n < count; ++n) {
@@ -84,7 +82,8 @@ ActiveSet run_mlos(const PreparedInput& in, const GridProjector& projector, cons
   }
 
   // Slices concatenated in z order; each slice copies into its own range, in parallel.
-  ActiveSet set;
+  ActiveSet set = std::move(buffers.spare);
+  buffers.spare = {};
   std::vector<std::size_t> first(slices.size() + 1, 0);
   for (std::size_t k = 0; k < slices.size(); ++k) first[k + 1] = first[k] + slices[k].index.size();
   const std::size_t total = first.back();
@@ -92,11 +91,11 @@ ActiveSet run_mlos(const PreparedInput& in, const GridProjector& projector, cons
   set.value.resize(total);
 #pragma omp parallel for num_threads(in.threads) schedule(dynamic, 4)
   for (int k = 0; k < g.nz; ++k) {
-    SliceResult& s = slices[static_cast<std::size_t>(k)];
+    MlosBuffers::Slice& s = slices[static_cast<std::size_t>(k)];
     const std::size_t at = first[static_cast<std::size_t>(k)];
     std::copy(s.index.begin(), s.index.end(), set.index.begin() + at);
     std::copy(s.value.begin(), s.value.end(), set.value.begin() + at);
-    s = {};
+    if (!settings.buffers) s = {};  // nobody keeps them: free early
   }
   return set;
 }

@@ -12,6 +12,20 @@
 
 namespace tomorig::recon::detail {
 
+// What MLOS allocates per run, kept by a reconstructor between its runs (the exposures and sets
+// of a session): the voxels found per z-slice and the arrays of the next active set. On this
+// machine the first touch of fresh memory costs more than the scan that fills it
+// (docs/performance.md, "Page faults"): the per-slice lists grow in 4 KiB pages, which made
+// MLOS the largest source of page faults in `tomorig process`.
+struct MlosBuffers {
+  struct Slice {
+    std::vector<std::uint32_t> index;
+    std::vector<float> value;
+  };
+  std::vector<Slice> slices;
+  ActiveSet spare;  // handed back by the caller once done with the last run's active set
+};
+
 struct MlosSettings {
   // Fraction of each image's maximum below which a pixel is empty (default: the one in
   // ReconstructionOptions).
@@ -20,6 +34,7 @@ struct MlosSettings {
   double fixed_bytes = 0.0;
   double bytes_per_voxel = 0.0;
   double memory_limit_mb = 0.0;  // 0: MemAvailable
+  MlosBuffers* buffers = nullptr;  // reused if given; else the run allocates its own
 };
 
 // Throws tomorig::Error (bad_input) if the support outgrows the memory limit.

@@ -174,13 +174,34 @@ void SparseSystem::with_weights(const Camera& cam, F&& kernel) const {
 }
 
 SparseSystem::SparseSystem(const PreparedInput& in, const std::vector<std::uint32_t>& index,
-                           const GridProjector& projector, int patch, int lut_steps)
+                           const GridProjector& projector, int patch, int lut_steps, SparseSystem* recycle)
     : patch_(patch), voxels_(index.size()) {
   const VoxelGrid& g = in.grid;
   const std::size_t plane = static_cast<std::size_t>(g.nx) * g.ny;
+  std::vector<Camera> old;
+  if (recycle) {
+    old = std::move(recycle->cams_);
+    scratch_ = std::move(recycle->scratch_);
+    *recycle = SparseSystem();
+  }
   std::size_t largest_image = 0;
   for (std::size_t c = 0; c < in.camera_count(); ++c) {
+    // A recycled camera's arrays are resized below (capacity kept, every entry rewritten); the
+    // ones this system does not use are emptied, as compact() and the kernels go by emptiness.
     Camera cam;
+    if (c < old.size()) {
+      Camera& o = old[c];
+      cam.measured = std::move(o.measured);
+      cam.projection = std::move(o.projection);
+      cam.log_ratio = std::move(o.log_ratio);
+      cam.offset = std::move(o.offset);
+      cam.row_u = std::move(o.row_u);
+      cam.row_v = std::move(o.row_v);
+      cam.row_2d = std::move(o.row_2d);
+      cam.row_u.clear();
+      cam.row_v.clear();
+      cam.row_2d.clear();
+    }
     const CameraImage& image = in.images[c];
     cam.width = image.width;
     cam.height = image.height;
@@ -239,7 +260,9 @@ SparseSystem::SparseSystem(const PreparedInput& in, const std::vector<std::uint3
     });
     cams_.push_back(std::move(cam));
   }
-  scratch_.resize(static_cast<std::size_t>(std::max(0, in.threads - 1)), std::vector<float>(largest_image, 0.0f));
+  // Each thread clears its scratch image before every projection, so only the size matters.
+  scratch_.resize(static_cast<std::size_t>(std::max(0, in.threads - 1)));
+  for (std::vector<float>& image : scratch_) image.resize(largest_image);
 }
 
 double SparseSystem::estimate_bytes(const PreparedInput& in, std::size_t voxels, int patch, int threads) {

@@ -22,9 +22,10 @@ struct PixelResidual {
 class SparseSystem {
  public:
   // index: the active voxels (ascending linear index); their image positions come from the
-  // projector. patch: p; lut_steps: sub-pixel steps.
+  // projector. patch: p; lut_steps: sub-pixel steps. `recycle` (may be null): a system no
+  // longer needed, whose arrays (already touched memory) this one takes over; it is left empty.
   SparseSystem(const PreparedInput& in, const std::vector<std::uint32_t>& index, const GridProjector& projector,
-               int patch, int lut_steps);
+               int patch, int lut_steps, SparseSystem* recycle = nullptr);
 
   // Memory estimate of a system of `voxels` voxels (index, intensity, scratch and per camera
   // offset + 2 LUT rows) plus its images, for the up-front check.
@@ -69,6 +70,8 @@ class SparseSystem {
   bool inside(std::size_t c, std::int32_t pixel) const;
 
  private:
+  SparseSystem() = default;  // the empty system a recycled one is left as
+
   struct Camera {
     int width = 0, height = 0, pad = 0, stride = 0;
     std::vector<float> measured;    // padded, 0 in the padding

@@ -17,7 +17,7 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 Support build_support(const ReconstructionInput& input, const ReconstructionOptions& options, const SupportNeeds& needs,
-                      ReconstructionReport& report) {
+                      ReconstructionReport& report, MlosBuffers* buffers) {
   const auto start = std::chrono::steady_clock::now();
   StageTimer timer("support");
   Support s;
@@ -70,6 +70,7 @@ Support build_support(const ReconstructionInput& input, const ReconstructionOpti
   mlos.fixed_bytes = fixed;
   mlos.bytes_per_voxel = per_voxel;
   mlos.memory_limit_mb = options.memory_limit_mb;
+  mlos.buffers = buffers;
   s.set = run_mlos(s.in, projector, mlos);
   timer.mark("mlos");
   report.active_voxels = s.set.size();

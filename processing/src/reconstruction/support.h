@@ -7,6 +7,7 @@
 
 #include "active_set.h"
 #include "grid_projector.h"
+#include "mlos.h"
 #include "prepared_input.h"
 #include "tomorig/processing/reconstruction/reconstructor.h"
 
@@ -28,9 +29,9 @@ struct SupportNeeds {
 };
 
 // Throws tomorig::Error (bad_input) as prepare_input, GridProjector and run_mlos do, and if the
-// estimated memory exceeds the limit.
+// estimated memory exceeds the limit. `buffers` (may be null): MLOS's, kept between runs.
 Support build_support(const ReconstructionInput& input, const ReconstructionOptions& options, const SupportNeeds& needs,
-                      ReconstructionReport& report);
+                      ReconstructionReport& report, MlosBuffers* buffers = nullptr);
 
 // The voxels of `set` whose intensity is > 0, as a sparse volume.
 SparseVolume to_volume(const VoxelGrid& grid, const std::vector<std::uint32_t>& index, const std::vector<float>& e);

@@ -94,6 +94,19 @@ struct BackendHooks {
   std::function<void(const BackendStep&)> step;
 };
 
+// Where a run's time went: each stage's wall seconds summed over the sets processed. With
+// reconstruction and correlation overlapped the stages of different sets run at the same time,
+// so the sum can exceed the run's seconds; --sequential separates them.
+struct BackendStageSeconds {
+  double load = 0.0;            // reading the set's frames from the session
+  double preprocess = 0.0;      // the preprocessing chain (0 without --chain)
+  double reconstruction = 0.0;  // both exposures (and --smooth)
+  double correlation = 0.0;     // the vector field and the set's report
+  double write = 0.0;           // adding the set to the results file
+
+  BackendStageSeconds& operator+=(const BackendStageSeconds& o);
+};
+
 struct BackendReport {
   std::filesystem::path out, xdmf, session;
   std::uint64_t sets_asked = 0;      // sets of the session to be in the file (max_sets applied)
@@ -108,6 +121,11 @@ struct BackendReport {
   Vec3d mean_displacement_voxel;     // spatial mean of the ensemble mean displacement
   Vec3d spatial_std_displacement_voxel;
   double seconds = 0.0;
+  // A single process: its stages' seconds, and the CPU time (all threads) and minor page faults
+  // of the run (the machine's hidden cost, docs/performance.md "Page faults"). Not under MPI.
+  BackendStageSeconds stage_seconds;
+  double cpu_user_seconds = 0.0, cpu_system_seconds = 0.0;
+  long minor_page_faults = 0;
   // Under MPI (on rank 0; a single process leaves them empty): every rank's share.
   std::vector<BackendRankFigures> ranks;
   // Under MPI on a rank other than 0: this rank only worked for rank 0, which reports the run;
