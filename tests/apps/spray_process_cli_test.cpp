@@ -139,6 +139,17 @@ TEST_F(SprayProcess, TheMeanIntensityVolumeLiesWhereTheTruthsDropletsAre) {
                                       " --psf truth -o " + shell_quoted(mean.string()));
   EXPECT_EQ(again.exit_code, 2) << again.err;
   EXPECT_NE(again.err.find("--overwrite"), std::string::npos) << again.err;
+  // The mean's options belong to it, and one set's to one set.
+  const fs::path other = dir / "other.h5";
+  const CliResult sets_alone = run_tomorig("reconstruct " + shell_quoted(session.string()) + " --sets 2" + grid +
+                                           " -o " + shell_quoted(other.string()));
+  EXPECT_EQ(sets_alone.exit_code, 2) << sets_alone.err;
+  EXPECT_NE(sets_alone.err.find("--mean"), std::string::npos) << sets_alone.err;
+  const CliResult one_set = run_tomorig("reconstruct " + shell_quoted(session.string()) + " --mean --set 1" + grid +
+                                        " -o " + shell_quoted(other.string()));
+  EXPECT_EQ(one_set.exit_code, 2) << one_set.err;
+  EXPECT_NE(one_set.err.find("--set does not apply"), std::string::npos) << one_set.err;
+  EXPECT_FALSE(fs::exists(other));
 }
 
 // Each blob's size class from its own light (optics/droplet_size.h), at the reconstruction's
