@@ -142,6 +142,7 @@ void run(const ReconstructArgs& args) {
                                {"relaxation", options.relaxation},
                                {"sigma_px", args.recon.sigma_px},
                                {"psf", args.recon.psf},
+                               {"chain", args.chain},
                                {"smoothing_sigma_voxel", args.smooth},
                                {"cameras", cameras.source},
                                {"dt_ns", set.dt_ns}};
