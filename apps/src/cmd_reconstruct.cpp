@@ -1,4 +1,5 @@
-// tomorig reconstruct: one set of a session -> a volume file (HDF5 + XDMF) per exposure.
+// tomorig reconstruct: one set of a session -> a volume file (HDF5 + XDMF) per exposure; with
+// --mean the mean intensity volume over --sets (spray statistics, pipeline/mean_volume.h).
 #include <chrono>
 #include <filesystem>
 #include <memory>
@@ -13,7 +14,9 @@
 #include "tomorig/pipeline/report_json.h"
 #include "json_summary.h"
 #include "tomorig/core/cli_vocabulary.h"
+#include "tomorig/pipeline/mean_volume.h"
 #include "tomorig/pipeline/session_geometry.h"
+#include "tomorig/pipeline/session_preprocessor.h"
 #include "tomorig/config/rig_config.h"
 #include "tomorig/core/error.h"
 #include "tomorig/processing/quality/depth_profile_plot.h"
@@ -49,6 +52,11 @@ struct ReconstructArgs {
   std::string png;  // intensity-versus-depth plot
   bool sparse_only = false;
   std::vector<double> smooth;  // sigma x, y, z in voxels; empty: none
+  std::string chain;           // preprocessing preset or chain TOML; empty: none
+  bool mean = false;           // the mean intensity volume over `sets`
+  std::string sets;
+  std::string slices;          // --mean: folder for the PNG slices
+  CLI::Option* set_opt = nullptr;
 };
 
 std::vector<Exposure> exposures_of(const std::string& name) {
@@ -71,8 +79,47 @@ std::vector<Image> exposure_images(const FrameSet& set, Exposure e, const std::s
   return images;
 }
 
+void run_mean(const ReconstructArgs& args) {
+  if (args.set_opt->count()) throw bad_input("--mean averages the sets of --sets (default all): --set does not apply");
+  if (!args.png.empty()) throw bad_input("--png draws one set's depth profile; with --mean use --slices FOLDER");
+  pipeline::MeanVolumeOptions o;
+  o.session = args.session;
+  o.calib = args.calib;
+  o.chain = args.chain;
+  o.recon = args.recon;
+  o.sets = args.sets;
+  o.exposures = exposures_of(args.exposure);
+  o.smooth = args.smooth;
+  o.out = args.out;
+  o.slices = args.slices;
+  o.sparse_only = args.sparse_only;
+  o.overwrite = args.overwrite;
+  const pipeline::MeanVolumeReport r = pipeline::write_mean_volume(o, [](int done, int total) {
+    fmt::print(stderr, "mean: volume {}/{} reconstructed\n", done, total);
+  });
+  nlohmann::json summary = json_summary("reconstruct");
+  summary.update(nlohmann::json{{"out", args.out},
+                                {"xdmf", storage::VolumeFileWriter::sidecar_path(args.out).string()},
+                                {"session", args.session},
+                                {"mean", to_json(r)}});
+  emit_json(args.json, summary);
+  if (args.json.to_stdout()) return;
+  const quality::IntensityMoments& m = r.moments;
+  fmt::print("wrote {} and {}: mean of {} volumes ({} sets), {}\n", args.out,
+             storage::VolumeFileWriter::sidecar_path(args.out).string(), r.volumes, r.sets.size(), r.algorithm);
+  fmt::print("intensity centroid ({:.2f}, {:.2f}, {:.2f}) mm; 90 % of it in x {:.2f}..{:.2f}, y {:.2f}..{:.2f}, "
+             "z {:.2f}..{:.2f} mm\n",
+             m.centroid_mm.x, m.centroid_mm.y, m.centroid_mm.z, m.low_mm.x, m.high_mm.x, m.low_mm.y, m.high_mm.y,
+             m.low_mm.z, m.high_mm.z);
+  if (!r.slice_files.empty())
+    fmt::print("slices: {} PNG in {}\n", r.slice_files.size(), args.slices);
+}
+
 void run(const ReconstructArgs& args) {
   cli::require_session(args.session, "reconstruct");
+  if (args.mean) return run_mean(args);
+  if (!args.sets.empty() || !args.slices.empty())
+    throw bad_input("--sets and --slices belong to --mean (the mean intensity volume over sets); one set is --set K");
   if (!args.png.empty()) storage::check_output_path(args.png, args.overwrite, "plot");  // before any work
   const storage::SessionReader session(args.session);
   if (args.set >= session.set_count())
@@ -88,12 +135,14 @@ void run(const ReconstructArgs& args) {
   const auto reconstructor = recon::make_reconstructor(options);
   recon::ReconstructionInput& input = setup.input;
 
-  const FrameSet set = session.read_set(args.set);
+  FrameSet set = session.read_set(args.set);
+  pipeline::SessionPreprocessor(session, args.chain).apply(set);
   nlohmann::json parameters = {{"algorithm", options.algorithm},
                                {"max_iterations", options.max_iterations},
                                {"relaxation", options.relaxation},
                                {"sigma_px", args.recon.sigma_px},
                                {"psf", args.recon.psf},
+                               {"chain", args.chain},
                                {"smoothing_sigma_voxel", args.smooth},
                                {"cameras", cameras.source},
                                {"dt_ns", set.dt_ns}};
@@ -147,7 +196,14 @@ void add_reconstruct_command(CLI::App& root) {
   cmd->add_option("--calib", args->calib,
                   "Calibration file (TOML, from tomorig calibrate), or 'truth' for a simulated session's exact cameras "
                   "(default: the truth if present, else the rig config's calibration file)");
-  cmd->add_option("--set", args->set, "Set index, 0-based")->capture_default_str();
+  args->set_opt = cmd->add_option("--set", args->set, "Set index, 0-based")->capture_default_str();
+  cmd->add_option("--chain", args->chain,
+                  "Preprocessing before the reconstruction: a preset (e.g. shadow-a, shadow-b) or a chain TOML");
+  cmd->add_flag("--mean", args->mean,
+                "Write the mean intensity volume over --sets (spray statistics, docs/spray.md) instead of one set");
+  cmd->add_option("--sets", args->sets, "--mean: sets to average (N, A:B or a list); default all");
+  cmd->add_option("--slices", args->slices,
+                  "--mean: folder for PNG slices of the mean (through its centroid, and 5 over the depth)");
   cmd->add_option("--exposure", args->exposure, "a, b or both")
       ->check(CLI::IsMember({"a", "b", "both", "A", "B"}))
       ->capture_default_str();

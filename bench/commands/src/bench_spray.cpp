@@ -24,6 +24,7 @@
 #include "tomorig/pipeline/session_geometry.h"
 #include "tomorig/pipeline/session_preprocessor.h"
 #include "tomorig/pipeline/spray_psf.h"
+#include "tomorig/processing/optics/droplet_size.h"
 #include "tomorig/processing/optics/visibility.h"
 #include "tomorig/processing/particles/droplets.h"
 #include "tomorig/processing/reconstruction/reconstructor.h"
@@ -47,6 +48,16 @@ struct BenchSprayArgs {
   // the visibility limit next to bright ones (docs/accuracy.md).
   pipeline::ReconstructionChoices recon{.algorithm = "ment", .algorithm_from_rig = false};
   std::string json_out;
+  // A blob's integrated intensity per pixel of light its droplet removed (full-depth shadow =
+  // 1 per pixel): the reconstruction's scale. 0: fitted on this session's matched droplets.
+  double shadow_scale = 0.0;
+};
+
+struct MatchedBlob {  // a detected droplet, for the size estimate
+  double integrated;
+  double d_truth_um;
+  std::size_t truth_class;
+  bool above_limit;
 };
 
 struct Cell {  // droplets of one size class in one depth bin
@@ -55,6 +66,8 @@ struct Cell {  // droplets of one size class in one depth bin
 
 struct ClassFigures {
   std::vector<Cell> depth;
+  std::vector<int> estimated;  // matched droplets by estimated class: below, the classes, above
+  double d_est_sum_um = 0;
   Cell all;
   double d_eq_sum_um = 0;  // of the matched detections
   Vec3d position_sq;       // squared position errors of the matched, mm^2
@@ -111,6 +124,19 @@ std::string class_name(const std::vector<double>& edges, std::size_t k) {
   return fmt::format("{:g}-{:g}", edges[k], edges[k + 1]);
 }
 
+// The column of diameter d among the estimated classes: 0 below the first edge, k + 1 for class
+// k, classes + 1 at or above the last edge.
+std::size_t estimated_column(const std::vector<double>& edges, double d) {
+  return static_cast<std::size_t>(std::upper_bound(edges.begin(), edges.end(), d) - edges.begin());
+}
+
+std::vector<std::string> estimated_columns(const std::vector<double>& edges) {
+  std::vector<std::string> names{fmt::format("<{:g}", edges.front())};
+  for (std::size_t k = 0; k + 1 < edges.size(); ++k) names.push_back(class_name(edges, k));
+  names.push_back(fmt::format(">={:g}", edges.back()));
+  return names;
+}
+
 nlohmann::json cell_json(const Cell& c) {
   return {{"truth", c.truth},
           {"detected", c.detected},
@@ -127,6 +153,8 @@ void run(const BenchSprayArgs& args) {
     throw bad_input("--classes needs at least two ascending diameters in um, e.g. 5,10,15,20,30,50,100");
   if (args.depth_bins < 1 || args.depth_bins > 50) throw bad_input("--depth-bins must be 1 to 50");
   if (!(args.match_voxels > 0)) throw bad_input("--match-voxels must be > 0");
+  if (!(args.shadow_scale >= 0))
+    throw bad_input("--shadow-scale must be > 0 (0 or none: fitted on this session's truth)");
   args.detection.validate();
   const storage::SessionReader session(args.session);
   const pipeline::SessionDescription description = pipeline::describe_session(session);
@@ -142,6 +170,11 @@ void run(const BenchSprayArgs& args) {
   // The predicted limit comes from the same optics as the PSF.
   const std::vector<optics::VisibilityRow> limit_rows =
       optics::visibility_table(pipeline::spray_optics_setup(choices.psf, description.truth));
+  // Each blob's own size: the diameter whose shadow removes the light the blob holds, averaged
+  // over the views (optics/droplet_size.h), with the cameras' object pixels of the case.
+  std::vector<double> object_pixel_um;
+  for (const sim::SprayCamera& c : spray.cameras) object_pixel_um.push_back(c.pixel_pitch_um / c.magnification);
+  const optics::DropletSizeModel size_model(pipeline::spray_optics_setup(choices.psf, description.truth), object_pixel_um);
   pipeline::SessionPreprocessor preprocessor(session, args.chain);
   std::optional<storage::ResultsReader> results;
   if (!args.results.empty()) results.emplace(args.results);
@@ -150,7 +183,12 @@ void run(const BenchSprayArgs& args) {
       (args.sets.empty() ? SetSelection() : SetSelection::parse(args.sets)).indices(session.set_count());
   const std::size_t classes = args.classes_um.size() - 1;
   std::vector<ClassFigures> figures(classes);
-  for (ClassFigures& f : figures) f.depth.resize(static_cast<std::size_t>(args.depth_bins));
+  for (ClassFigures& f : figures) {
+    f.depth.resize(static_cast<std::size_t>(args.depth_bins));
+    f.estimated.assign(classes + 2, 0);
+  }
+  std::vector<double> blob_integrated;  // every blob, matched or not
+  std::vector<MatchedBlob> matched_blobs;
   const double z_lo = grid.origin.z, z_hi = grid.origin.z + (grid.nz - 1) * grid.voxel_size;
   const double margin = 2 * grid.voxel_size;  // a droplet at a face is half a blob
   const double match_mm = args.match_voxels * grid.voxel_size;
@@ -169,6 +207,7 @@ void run(const BenchSprayArgs& args) {
     const DenseVolume volume = reconstructor->reconstruct(input, report).to_dense();
     const std::vector<particles::DetectedDroplet> found = particles::detect_droplets(volume, args.detection);
     detections += static_cast<int>(found.size());
+    for (const particles::DetectedDroplet& f : found) blob_integrated.push_back(f.integrated);
 
     std::vector<TruthDroplet> truth = spray_truth_droplets(session, spray, k);
     std::erase_if(truth, [&](const TruthDroplet& d) {
@@ -226,6 +265,7 @@ void run(const BenchSprayArgs& args) {
       if (detected) {
         const particles::DetectedDroplet& f = found[static_cast<std::size_t>(match[t])];
         fig.d_eq_sum_um += f.d_eq_mm * 1e3;
+        matched_blobs.push_back({f.integrated, d.d_um, c, above});
         const Vec3d e = f.world - d.a;
         fig.position_sq = fig.position_sq + Vec3d{e.x * e.x, e.y * e.y, e.z * e.z};
       }
@@ -252,7 +292,40 @@ void run(const BenchSprayArgs& args) {
   }
 
   // The table and the JSON.
+  // The size estimate: each blob's diameter from its light, at the given scale or the one that
+  // fits this session's droplets above the limit best (the median ratio: robust to merged blobs).
+  double scale = args.shadow_scale;
+  if (!(scale > 0)) {
+    std::vector<double> ratios;
+    for (const MatchedBlob& m : matched_blobs)
+      if (m.above_limit) ratios.push_back(m.integrated / size_model.removed_px(m.d_truth_um));
+    if (!ratios.empty()) {
+      std::nth_element(ratios.begin(), ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2), ratios.end());
+      scale = ratios[ratios.size() / 2];
+    }
+  }
+  std::vector<int> blobs_by_estimate(classes + 2, 0);
+  if (scale > 0) {
+    for (const double integrated : blob_integrated)
+      ++blobs_by_estimate[estimated_column(args.classes_um, size_model.diameter_um(integrated / scale))];
+    for (const MatchedBlob& m : matched_blobs) {
+      const double estimate = size_model.diameter_um(m.integrated / scale);
+      figures[m.truth_class].d_est_sum_um += estimate;
+      ++figures[m.truth_class].estimated[estimated_column(args.classes_um, estimate)];
+    }
+  }
   Cell above_total;
+  int matched = 0, same_class = 0, within_one = 0;
+  nlohmann::json confusion = nlohmann::json::array();
+  for (std::size_t c = 0; c < classes; ++c) {
+    const std::vector<int>& row = figures[c].estimated;
+    for (std::size_t col = 0; col < row.size(); ++col) {
+      matched += row[col];
+      if (col == c + 1) same_class += row[col];
+      if (col + 1 >= c + 1 && col <= c + 2) within_one += row[col];
+    }
+    confusion.push_back({{"truth_class", class_name(args.classes_um, c)}, {"estimated", row}});
+  }
   nlohmann::json classes_json = nlohmann::json::array();
   for (std::size_t c = 0; c < classes; ++c) {
     const ClassFigures& f = figures[c];
@@ -269,6 +342,8 @@ void run(const BenchSprayArgs& args) {
     cj["d_um"] = {args.classes_um[c], args.classes_um[c + 1]};
     cj["depth"] = depth;
     cj["d_eq_mean_um"] = json_number(n > 0 ? f.d_eq_sum_um / n : NAN);
+    cj["d_est_mean_um"] = json_number(n > 0 ? f.d_est_sum_um / n : NAN);
+    cj["estimated_same_class_fraction"] = json_number(n > 0 ? f.estimated[c + 1] / n : NAN);
     cj["position_rms_um"] = {json_number(n > 0 ? std::sqrt(f.position_sq.x / n) * 1e3 : NAN),
                              json_number(n > 0 ? std::sqrt(f.position_sq.y / n) * 1e3 : NAN),
                              json_number(n > 0 ? std::sqrt(f.position_sq.z / n) * 1e3 : NAN)};
@@ -304,6 +379,17 @@ void run(const BenchSprayArgs& args) {
       {"detections", detections},
       {"unmatched_detections", unmatched_detections},
       {"sets_with_velocity", sets_with_velocity},
+      {"size_estimate",
+       {{"method", "the diameter whose shadow removes the blob's integrated intensity / shadow_scale, (1 - tau) pi d^2 / 4 "
+                   "averaged over the views"},
+        {"shadow_scale", json_number(scale > 0 ? scale : NAN)},
+        {"shadow_scale_source", args.shadow_scale > 0 ? "--shadow-scale" : "fitted on this session's truth"},
+        {"columns", estimated_columns(args.classes_um)},
+        {"confusion", confusion},
+        {"matched", matched},
+        {"same_class_fraction", json_number(matched ? double(same_class) / matched : NAN)},
+        {"within_one_class_fraction", json_number(matched ? double(within_one) / matched : NAN)},
+        {"blobs_by_estimated_class", blobs_by_estimate}}},
       {"classes", classes_json},
       {"machine", machine_json()}};
   if (args.json_out.empty() || args.json_out == "-") {
@@ -329,6 +415,23 @@ void run(const BenchSprayArgs& args) {
   fmt::print("above the predicted limit: {} of {} detected ({} %); {} blobs, {} unmatched\n", above_total.above_detected,
              above_total.above_limit, percent(above_total.above_detected, above_total.above_limit), detections,
              unmatched_detections);
+  fmt::print("size class estimated from each blob's intensity (rows: truth class, columns: estimated; matched droplets)\n{:>10}",
+             "d [um]");
+  const std::vector<std::string> columns = estimated_columns(args.classes_um);
+  for (const std::string& c : columns) fmt::print(" {:>7}", c);
+  fmt::print(" {:>8} {:>8}\n", "same %", "d_est um");
+  for (std::size_t c = 0; c < classes; ++c) {
+    const ClassFigures& f = figures[c];
+    fmt::print("{:>10}", class_name(args.classes_um, c));
+    for (const int n : f.estimated) fmt::print(" {:>7}", n);
+    fmt::print(" {:>8} {:>8.1f}\n", percent(f.estimated[c + 1], f.all.detected),
+               f.all.detected ? f.d_est_sum_um / f.all.detected : NAN);
+  }
+  fmt::print("estimated class = truth class for {} of {} matched droplets ({} %), within one class {} %; shadow scale "
+             "{:.4g} ({})\n",
+             same_class, matched, percent(same_class, matched), percent(within_one, matched), scale,
+             args.shadow_scale > 0 ? "--shadow-scale" : "fitted on this session's truth: pass it as --shadow-scale "
+                                                        "for sessions of the same rig, chain and grid");
   if (sets_with_velocity > 0) {
     fmt::print("velocity RMS error against truth [m/s] (3-D correlation at each droplet above the limit)\n{:>10} {:>6} {:>9} {:>7} {:>7} {:>7} {:>7}\n",
                "d [um]", "n", "speed", "u", "v", "w", "|e|");
@@ -369,6 +472,9 @@ void add_bench_spray_command(CLI::App& bench) {
   cmd->add_option("--peak-threshold", args->detection.relative_peak_threshold,
                   "A blob's peak must exceed this fraction of the volume's brightest voxel (0: every local maximum)")
       ->capture_default_str();
+  cmd->add_option("--shadow-scale", args->shadow_scale,
+                  "A blob's integrated intensity per pixel of light its droplet removed, for each blob's size class "
+                  "(default: fitted on this session's truth and reported, to pass on for other sessions)");
   cmd->add_option("--json", args->json_out, "Write the JSON to FILE (.json) and print the tables; '-' or none: JSON on stdout")
       ->expected(0, 1);
   cmd->footer("--psf defaults to 'truth' (the session's simulated PSF); the predicted limit uses the same optics.");

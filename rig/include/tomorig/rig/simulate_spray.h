@@ -26,6 +26,11 @@ sim::SprayPattern parse_spray_pattern(const std::string& word, const std::string
 // The optics set-up of a case as the TOML `tomorig optics visibility --setup` reads.
 std::string spray_optics_setup_toml(const sim::SprayCase& c);
 
+// The rig config of the case as `tomorig run --config` reads it (the example rig's layout): the
+// four simulated cameras, the 25 Hz trigger with the pulse separation, [simulation] with the
+// seed, pattern, noise and pulse B's energy. Written into the sessions `write_spray_session` makes.
+std::string spray_rig_config_toml(const sim::SprayCase& c, int sets);
+
 // Renders `sets` sets and writes the session; returns a one-line summary. Throws bad_input if
 // the file exists and `overwrite` is false, or for sets < 1.
 std::string write_spray_session(const sim::SprayOptions& options, int sets, const std::filesystem::path& out,
