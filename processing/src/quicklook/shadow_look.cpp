@@ -230,14 +230,6 @@ void ShadowLook::analyse(const Image& image, ShadowFrame& out) {
     return s;
   };
   const auto tile_level = [&](int i, int j) { return out.level_map.values[static_cast<std::size_t>(i + tx * j)]; };
-  // The bright field at working position (px, py).
-  const auto field_at = [&](double px, double py) {
-    const Stencil sx = stencil(px, tx, w), sy = stencil(py, ty, h);
-    float level = 0;
-    for (int a = 0; a < 3; ++a)
-      for (int c = 0; c < 3; ++c) level += sy.weight[a] * sx.weight[c] * tile_level(sx.tile[c], sy.tile[a]);
-    return level;
-  };
   columns_.resize(static_cast<std::size_t>(w));
   for (int x = 0; x < w; ++x) columns_[static_cast<std::size_t>(x)] = stencil(x + 0.5, tx, w);
   row_levels_.resize(static_cast<std::size_t>(tx));
@@ -296,8 +288,11 @@ void ShadowLook::analyse(const Image& image, ShadowFrame& out) {
     for (std::size_t k = 0; k < pixels; k += frame_stride) {
       const int x = static_cast<int>(k % static_cast<std::size_t>(fwb)), y = static_cast<int>(k / static_cast<std::size_t>(fwb));
       if (x + 1 >= fwb) continue;
-      const float level = field_at((x + 0.5) / b, (y + 0.5) / b);
-      if (level > 0) tile_buffer_.push_back(std::abs(frame_pixel(image, x + 1, y) - frame_pixel(image, x, y)) / level);
+      // The bright field of the working pixel holding (x, y): its value over its normalised one.
+      const std::size_t kb = static_cast<std::size_t>(y / b) * w + static_cast<std::size_t>(x / b);
+      if (!(normalised_[kb] > 0 && working_[kb] > 0)) continue;
+      const float level = working_[kb] / normalised_[kb];
+      tile_buffer_.push_back(std::abs(frame_pixel(image, x + 1, y) - frame_pixel(image, x, y)) / level);
     }
     out.noise = mad_to_sigma * median_of(tile_buffer_);
   }
