@@ -7,6 +7,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <type_traits>
 
 #include <fmt/core.h>
 
@@ -50,11 +51,6 @@ void copy_frame(const Image& image, std::vector<float>& out) {
     float* row = out.data() + static_cast<std::size_t>(y) * w;
     for (int x = 0; x < w; ++x) row[x] = static_cast<float>(in[x]);
   }
-}
-
-float frame_pixel(const Image& image, int x, int y) {
-  return image.type() == SampleType::u16 ? static_cast<float>(image.row<std::uint16_t>(y)[x])
-                                         : static_cast<float>(image.row<std::uint8_t>(y)[x]);
 }
 
 // A figure judged against a target the rig may leave unset: then it is reported, green.
@@ -281,19 +277,29 @@ void ShadowLook::analyse(const Image& image, ShadowFrame& out) {
   out.working_noise = mad_to_sigma * median_of(tile_buffer_);
   out.noise = out.working_noise;
   if (b > 1) {
+    // Whole rows at a stride, read in order: a sample scattered over the frame would miss the
+    // cache at every pixel, which cost more than binning the frame.
     tile_buffer_.clear();
-    const int fwb = w * b;
-    const std::size_t pixels = static_cast<std::size_t>(fwb) * static_cast<std::size_t>(h * b);
-    const std::size_t frame_stride = std::max<std::size_t>(1, pixels / samples) | 1;
-    for (std::size_t k = 0; k < pixels; k += frame_stride) {
-      const int x = static_cast<int>(k % static_cast<std::size_t>(fwb)), y = static_cast<int>(k / static_cast<std::size_t>(fwb));
-      if (x + 1 >= fwb) continue;
-      // The bright field of the working pixel holding (x, y): its value over its normalised one.
-      const std::size_t kb = static_cast<std::size_t>(y / b) * w + static_cast<std::size_t>(x / b);
-      if (!(normalised_[kb] > 0 && working_[kb] > 0)) continue;
-      const float level = working_[kb] / normalised_[kb];
-      tile_buffer_.push_back(std::abs(frame_pixel(image, x + 1, y) - frame_pixel(image, x, y)) / level);
-    }
+    const int fwb = w * b, fhb = h * b;
+    const int rows = std::max(1, static_cast<int>(samples / static_cast<std::size_t>(fwb - 1)));
+    const int row_stride = std::max(1, fhb / rows);
+    const auto sample_rows = [&](const auto* type_tag) {
+      using T = std::remove_const_t<std::remove_pointer_t<decltype(type_tag)>>;
+      for (int y = row_stride / 2; y < fhb; y += row_stride) {
+        const T* in = image.row<T>(y);
+        const float* norm = normalised_.data() + static_cast<std::size_t>(y / b) * w;
+        const float* work = working_.data() + static_cast<std::size_t>(y / b) * w;
+        for (int x = 0; x + 1 < fwb; ++x) {
+          // The bright field of the working pixel holding (x, y): its value over its normalised one.
+          const int xb = x / b;
+          if (!(norm[xb] > 0 && work[xb] > 0)) continue;
+          const float level = work[xb] / norm[xb];
+          tile_buffer_.push_back(std::abs(static_cast<float>(in[x + 1]) - static_cast<float>(in[x])) / level);
+        }
+      }
+    };
+    if (wide) sample_rows(static_cast<const std::uint16_t*>(nullptr));
+    else sample_rows(static_cast<const std::uint8_t*>(nullptr));
     out.noise = mad_to_sigma * median_of(tile_buffer_);
   }
   out.threshold = 1.0 - options_.shadow_sigmas * std::max(out.working_noise, 1e-4);
