@@ -84,6 +84,26 @@ void decode_quicklook(TableReader& root, QuickLookConfig& q) {
     read_optional(*p, "ment_iterations", q.preview.ment_iterations, in_closed(1, 20));
     p->report_unknown_keys();
   }
+  if (auto p = r->table("spray")) {
+    read_optional(*p, "coverage_max", q.spray.coverage_max, in_left_open(0.0, 1.0));
+    read_optional(*p, "uniformity_min", q.spray.uniformity_min, in_left_open(0.0, 1.0));
+    read_optional(*p, "energy_tolerance", q.spray.energy_tolerance, Rule<double>{[](const double& v) -> std::optional<std::string> {
+      if (v > 0 && v < 1) return std::nullopt;
+      return std::string("must be in (0, 1): the fraction pulse energies may differ and stay green");
+    }});
+    read_range(*p, "bright_fraction", q.spray.bright_fraction);
+    if (q.spray.bright_fraction && (*q.spray.bright_fraction)[1] > 1) {
+      p->issue("bright_fraction", fmt::format("[{}, {}] reaches above full scale: the high end must be at most 1",
+                                              (*q.spray.bright_fraction)[0], (*q.spray.bright_fraction)[1]));
+      q.spray.bright_fraction.reset();
+    }
+    read_range(*p, "shadow_count", q.spray.shadow_count);
+    read_optional(*p, "min_intensity_max", q.spray.min_intensity_max, in_left_open(0.0, 1.0));
+    read_optional(*p, "binning", q.spray.binning, in_closed(0, 8));
+    read_optional(*p, "shadow_sigmas", q.spray.shadow_sigmas, in_closed(1.0, 50.0));
+    read_optional(*p, "reference_sets", q.spray.reference_sets, in_closed(1, 10000));
+    p->report_unknown_keys();
+  }
   r->report_unknown_keys();
 }
 

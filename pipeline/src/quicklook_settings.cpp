@@ -82,6 +82,26 @@ QuickLookSettings quicklook_settings(const config::RigConfig* rig) {
   apply(q.preview.mlos_threshold, p.mlos_threshold);
   apply(q.preview.ment_iterations, p.ment_iterations);
   validate(p, "quicklook.preview");
+
+  quicklook::ShadowLookOptions& sh = s.shadow;
+  quicklook::ShadowTargets& sp = sh.targets;
+  apply_max(q.spray.coverage_max, sp.shadow_coverage);
+  apply_min(q.spray.uniformity_min, sp.uniformity);
+  if (q.spray.energy_tolerance) {
+    sp.energy_ratio.low = 1.0 - *q.spray.energy_tolerance;
+    sp.energy_ratio.high = 1.0 + *q.spray.energy_tolerance;
+  }
+  apply(q.spray.bright_fraction, sp.bright_fraction);
+  // Targets the library leaves unset (judged only when the rig sets them), with its amber bands.
+  using Spray = quicklook::ShadowTargets;
+  if (q.spray.shadow_count)
+    sp.shadow_count = quicklook::Target{(*q.spray.shadow_count)[0], (*q.spray.shadow_count)[1], Spray::shadow_count_amber};
+  if (q.spray.min_intensity_max)
+    sp.min_intensity = quicklook::Target{0.0, *q.spray.min_intensity_max, Spray::min_intensity_amber};
+  apply(q.spray.binning, sh.binning);
+  apply(q.spray.shadow_sigmas, sh.shadow_sigmas);
+  apply(q.spray.reference_sets, sh.reference_sets);
+  validate(sh, "quicklook.spray");
   return s;
 }
 

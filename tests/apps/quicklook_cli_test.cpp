@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -80,6 +81,31 @@ TEST(QuicklookCli, BenchReportsLossLatenessAndTheQuickLooksCpuTime) {
   const CliResult bad = run_tomorig(common + " --quicklook maybe");
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("--quicklook maybe"), std::string::npos) << bad.err;
+}
+
+// The spray rig's case (reduced here; the full 2560 x 2160 is the default) with the quick-look
+// alone: its shadow mode, and the ms per set the lead times quietly (docs/spray.md).
+TEST(QuicklookCli, BenchTimesTheSprayQuickLookPerSetWithoutTheRecorder) {
+  TempDir dir;
+  const CliResult r = run_tomorig("bench quicklook --case spray-thesis --reduced --recorder off --sets 3 --distinct 1 "
+                                  "--rate 25 --publish none --folder " + shell_quoted(dir.path().string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["case"], "spray-thesis");
+  EXPECT_EQ(j["cameras"], 4);
+  EXPECT_EQ(j["width"], 640);
+  EXPECT_TRUE(j["recorder"].is_null());
+  const nlohmann::json& q = j["quicklook"];
+  EXPECT_EQ(q["status"]["mode"], "shadow");
+  EXPECT_EQ(q["analysed"].get<int>() + q["skipped"].get<int>(), 3);
+  EXPECT_GT(q["cpu_ms_per_set"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(q["period_ms"].get<double>(), 40.0);
+  EXPECT_FALSE(std::filesystem::exists(dir / "tomorig-bench-quicklook.h5")) << "no recorder, no file";
+  EXPECT_NE(r.err.find("no recorder"), std::string::npos) << r.err;
+
+  const CliResult bad = run_tomorig("bench quicklook --reduced --recorder off --sets 1");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("--case spray-thesis"), std::string::npos) << bad.err;
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -121,6 +122,84 @@ TEST_F(SprayRun, QuickLookFlagsATwentyPercentLedDropBetweenPulses) {
   const CliResult inspect = run_tomorig("inspect --json " + shell_quoted(session.string()));
   ASSERT_EQ(inspect.exit_code, 0) << inspect.err;
   EXPECT_NE(inspect.out.find("energy_balance"), std::string::npos) << inspect.out.substr(0, 2000);
+}
+
+// The example rig with pulse B at `pulse_b` and a [quicklook.spray] table `targets`, run for 3
+// sets with the quick-look published: the 2 messages `tomorig preview --json` printed.
+std::vector<json> spray_quicklook_messages(const fs::path& dir, const std::string& pulse_b, const std::string& targets) {
+  const fs::path rig = edited_rig(dir / "rig.toml", "pulse_b_energy = 1.0", "pulse_b_energy = " + pulse_b);
+  std::ofstream(rig, std::ios::app) << "\n[quicklook.spray]\n" << targets << "\n";
+  const std::string endpoint = "ipc://" + (dir / "ql").string();
+  TomorigProcess preview({"preview", "--from", endpoint, "--json", "--count", "2", "--timeout", "120"});
+  EXPECT_TRUE(preview.wait_for_line("listening")) << preview.err();
+  const CliResult run = run_tomorig("run --config " + shell_quoted(rig.string()) + " --sets 3 --status none --preview " +
+                                    shell_quoted(endpoint) + " -o " + shell_quoted((dir / "s.h5").string()));
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(preview.wait(), 0) << preview.err();
+  std::vector<json> messages;
+  std::istringstream lines(preview.out());
+  std::string line;
+  while (std::getline(lines, line))
+    if (!line.empty()) messages.push_back(json::parse(line));
+  EXPECT_EQ(messages.size(), 2u);
+  return messages;
+}
+
+// The same 20 % drop is green for a rig whose [quicklook.spray] target allows 25 %; a droplet
+// count target the spray meets keeps the set green.
+TEST_F(SprayRun, QuickLookJudgesTheLedDropAgainstTheRigsEnergyTolerance) {
+  TempDir dir;
+  for (const json& j : spray_quicklook_messages(dir.path(), "0.8", "energy_tolerance = 0.25\nshadow_count = [50, 5000]")) {
+    EXPECT_EQ(j.at("flag"), "green") << j.dump().substr(0, 3000);
+    for (const json& cam : j.at("cameras")) {
+      const json& shadow = cam.at("shadow");
+      EXPECT_NEAR(shadow.at("energy_ratio").at("value").get<double>(), 0.8, 0.02);
+      EXPECT_EQ(shadow.at("energy_ratio").at("flag"), "green");
+      EXPECT_TRUE(shadow.at("led_energy_alarms").empty()) << shadow.at("led_energy_alarms").dump();
+      EXPECT_EQ(shadow.at("a").at("shadows").at("count_flag"), "green");
+      EXPECT_EQ(shadow.at("a").at("binning"), 1) << "640 x 540 frames are measured as they are";
+    }
+  }
+}
+
+// Equal pulses, but the rig expects a denser spray and deeper shadows than the simulated one:
+// the count and the deepest shadow are red, the pulse energies green.
+TEST_F(SprayRun, QuickLookFlagsASprayBelowTheRigsDropletTargets) {
+  TempDir dir;
+  for (const json& j : spray_quicklook_messages(dir.path(), "1.0", "shadow_count = [5000, 20000]\nmin_intensity_max = 0.01")) {
+    EXPECT_EQ(j.at("flag"), "red");
+    for (const json& cam : j.at("cameras")) {
+      const json& shadow = cam.at("shadow");
+      EXPECT_EQ(shadow.at("energy_ratio").at("flag"), "green");
+      EXPECT_TRUE(shadow.at("led_energy_alarms").empty());
+      EXPECT_LT(shadow.at("a").at("shadows").at("count").get<int>(), 5000 / 1.25);
+      EXPECT_EQ(shadow.at("a").at("shadows").at("count_flag"), "red");
+      EXPECT_GT(shadow.at("a").at("shadows").at("min_intensity").get<double>(), 0.011);
+      EXPECT_EQ(shadow.at("a").at("shadows").at("min_intensity_flag"), "red");
+      EXPECT_EQ(shadow.at("a").at("bright_field").at("fraction_flag"), "green");
+      EXPECT_EQ(shadow.at("a").at("flag"), "red");
+    }
+  }
+}
+
+TEST_F(SprayRun, BadSprayTargetsAreNamedBeforeAnyFile) {
+  TempDir dir;
+  for (const auto& [table, key, text] :
+       {std::tuple{"coverage_max = 1.5", "quicklook.spray.coverage_max", "(0, 1]"},
+        std::tuple{"energy_tolerance = 0", "quicklook.spray.energy_tolerance", "(0, 1)"},
+        std::tuple{"binning = 9", "quicklook.spray.binning", "[0, 8]"},
+        std::tuple{"bright_fraction = [0.5, 0.1]", "quicklook.spray.bright_fraction", "low <= high"},
+        std::tuple{"shadow_cuont = [1, 2]", "quicklook.spray.shadow_cuont", "shadow_count"}}) {
+    const fs::path rig = edited_rig(dir / "rig.toml", "pulse_b_energy = 1.0", "pulse_b_energy = 1.0");
+    std::ofstream(rig, std::ios::app) << "\n[quicklook.spray]\n" << table << "\n";
+    const fs::path out = dir / "s.h5";
+    const CliResult run = run_tomorig("run --config " + shell_quoted(rig.string()) + " --sets 1 --status none -o " +
+                                      shell_quoted(out.string()));
+    EXPECT_EQ(run.exit_code, 2) << table << "\n" << run.err;
+    EXPECT_NE(run.err.find(key), std::string::npos) << run.err;
+    EXPECT_NE(run.err.find(text), std::string::npos) << run.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
 }
 
 TEST_F(SprayRun, ARigTheCaseCannotRenderIsRefusedBeforeAnyFile) {

@@ -24,6 +24,9 @@ TEST(QuickLookConfig, AbsentKeysStayUnset) {
   EXPECT_FALSE(rig.quicklook.dt_check.displacement_px);
   EXPECT_FALSE(rig.quicklook.drift.warn_px);
   EXPECT_FALSE(rig.quicklook.preview.algorithm);
+  EXPECT_FALSE(rig.quicklook.spray.coverage_max);
+  EXPECT_FALSE(rig.quicklook.spray.shadow_count);
+  EXPECT_FALSE(rig.quicklook.spray.binning);
   // The default rig leaves them to the library too.
   const RigConfig def = default_rig_config();
   EXPECT_FALSE(def.quicklook.ppp);
@@ -86,6 +89,31 @@ ment_iterations = 3
   EXPECT_EQ(q.preview.ment_iterations, 3);
 }
 
+TEST(QuickLookConfig, EverySprayKeyIsRead) {
+  const RigConfig rig = parse_rig_config(rig_with(R"(
+[quicklook.spray]
+coverage_max = 0.08
+uniformity_min = 0.6
+energy_tolerance = 0.15
+bright_fraction = [0.04, 0.8]
+shadow_count = [200, 1500]
+min_intensity_max = 0.4
+binning = 2
+shadow_sigmas = 5
+reference_sets = 20
+)"));
+  const QuickLookConfig::Spray& q = rig.quicklook.spray;
+  EXPECT_EQ(q.coverage_max, 0.08);
+  EXPECT_EQ(q.uniformity_min, 0.6);
+  EXPECT_EQ(q.energy_tolerance, 0.15);
+  EXPECT_EQ(q.bright_fraction, (std::array<double, 2>{0.04, 0.8}));
+  EXPECT_EQ(q.shadow_count, (std::array<double, 2>{200, 1500}));
+  EXPECT_EQ(q.min_intensity_max, 0.4);
+  EXPECT_EQ(q.binning, 2);
+  EXPECT_EQ(q.shadow_sigmas, 5.0);
+  EXPECT_EQ(q.reference_sets, 20);
+}
+
 void expect_issue(const std::string& tail, const std::string& key, const std::string& at, const std::string& text) {
   const std::string doc = rig_with(tail);
   const auto issues = check_rig_config(doc, "rig.toml");
@@ -109,6 +137,18 @@ TEST(QuickLookConfig, BadValuesAreNamed) {
                "must be one of mlos, ment");
   expect_issue("[quicklook.drift]\nwarn = 0.3\n", "quicklook.drift.warn", "warn =", "did you mean \"warn_px\"?");
   expect_issue("[quicklook]\nppp_range = [0.1, 0.2]\n", "quicklook.ppp_range", "ppp_range", "unknown key");
+  expect_issue("[quicklook.spray]\ncoverage_max = 0\n", "quicklook.spray.coverage_max", "coverage_max", "must be in (0, 1]");
+  expect_issue("[quicklook.spray]\nenergy_tolerance = 1.2\n", "quicklook.spray.energy_tolerance", "energy_tolerance",
+               "must be in (0, 1)");
+  expect_issue("[quicklook.spray]\nbright_fraction = [0.1, 1.5]\n", "quicklook.spray.bright_fraction", "bright_fraction",
+               "at most 1");
+  expect_issue("[quicklook.spray]\nshadow_count = [900, 100]\n", "quicklook.spray.shadow_count", "shadow_count",
+               "low <= high");
+  expect_issue("[quicklook.spray]\nbinning = 12\n", "quicklook.spray.binning", "binning", "must be in [0, 8]");
+  expect_issue("[quicklook.spray]\nshadow_sigmas = 0.5\n", "quicklook.spray.shadow_sigmas", "shadow_sigmas",
+               "must be in [1, 50]");
+  expect_issue("[quicklook.spray]\nenergy_balance = [0.9, 1.1]\n", "quicklook.spray.energy_balance", "energy_balance",
+               "unknown key");
 }
 
 }  // namespace

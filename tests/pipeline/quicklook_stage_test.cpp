@@ -184,6 +184,38 @@ binning = 4
   EXPECT_EQ(s.preview.depth_factor, quicklook::PreviewVolumeOptions{}.depth_factor);
 }
 
+TEST(QuickLookSettings, SprayKeysSetTheShadowLooksTargets) {
+  const pipeline::QuickLookSettings defaults = pipeline::quicklook_settings(nullptr);
+  const quicklook::ShadowLookOptions library;
+  EXPECT_EQ(defaults.shadow.targets.energy_ratio.low, library.targets.energy_ratio.low);
+  EXPECT_EQ(defaults.shadow.binning, library.binning);
+  EXPECT_FALSE(defaults.shadow.targets.shadow_count) << "not judged unless the rig sets it";
+
+  const config::RigConfig rig = config::parse_rig_config(config::default_rig_toml() + R"(
+[quicklook.spray]
+coverage_max = 0.08
+energy_tolerance = 0.15
+shadow_count = [200, 1500]
+min_intensity_max = 0.4
+binning = 2
+)");
+  const pipeline::QuickLookSettings s = pipeline::quicklook_settings(&rig);
+  const quicklook::ShadowTargets& t = s.shadow.targets;
+  EXPECT_EQ(t.shadow_coverage.high, 0.08);
+  EXPECT_EQ(t.shadow_coverage.amber, library.targets.shadow_coverage.amber) << "amber bands stay the library's";
+  EXPECT_DOUBLE_EQ(t.energy_ratio.low, 0.85);
+  EXPECT_DOUBLE_EQ(t.energy_ratio.high, 1.15);
+  ASSERT_TRUE(t.shadow_count);
+  EXPECT_EQ(t.shadow_count->low, 200);
+  EXPECT_EQ(t.shadow_count->amber, quicklook::ShadowTargets::shadow_count_amber);
+  ASSERT_TRUE(t.min_intensity);
+  EXPECT_EQ(t.min_intensity->high, 0.4);
+  EXPECT_EQ(t.uniformity.low, library.targets.uniformity.low) << "absent: the library's";
+  EXPECT_EQ(t.bright_fraction.high, library.targets.bright_fraction.high);
+  EXPECT_EQ(s.shadow.binning, 2);
+  EXPECT_EQ(s.shadow.reference_sets, library.reference_sets);
+}
+
 TEST(QuickLookStage, FramesTooSmallForTheDtCheckStillGetTheirStatistics) {
   // 40 x 30 frames: statistics yes, no 64 px correlation window fits.
   std::vector<storage::SessionCamera> cameras = {{"tiny", 40, 30, PixelFormat::Mono16, 7.4}};

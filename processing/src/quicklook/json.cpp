@@ -57,20 +57,27 @@ void to_json(nlohmann::json& j, const CameraQuickLook& s) {
 }
 
 void to_json(nlohmann::json& j, const ShadowFrame& s) {
+  // count, min_intensity and fraction stay plain numbers (viewers read them so); their flags
+  // against the rig's targets sit beside them.
   j = {{"width", s.width},
        {"height", s.height},
+       {"binning", s.binning},
        {"bright_field",
         {{"level", number(s.bright_level)},
-         {"fraction", number(s.bright_fraction)},
+         {"fraction", number(s.bright_fraction.value)},
+         {"fraction_flag", s.bright_fraction.flag},
          {"noise", number(s.noise)},
+         {"working_noise", number(s.working_noise)},
          {"uniformity", s.uniformity},
          {"map", s.level_map}}},
        {"shadows",
         {{"threshold", number(s.threshold)},
          {"coverage", s.shadow_coverage},
-         {"count", s.shadows},
+         {"count", static_cast<std::uint64_t>(s.shadows.value)},
+         {"count_flag", s.shadows.flag},
          {"per_mpx", number(s.shadows_per_mpx)},
-         {"min_intensity", number(s.min_intensity)},
+         {"min_intensity", number(s.min_intensity.value)},
+         {"min_intensity_flag", s.min_intensity.flag},
          {"spray_tile_fraction", s.spray_tile_fraction},
          {"map", s.coverage_map}}},
        {"flag", s.overall()}};

@@ -118,7 +118,7 @@ struct SimulationConfig {
   double pulse_b_energy = 1.0;
 };
 
-// [quicklook], [quicklook.dt_check], [quicklook.drift], [quicklook.preview]: the targets and
+// [quicklook], [quicklook.dt_check], [quicklook.drift], [quicklook.preview], [quicklook.spray]: the targets and
 // settings of the quick-look stage (docs/quicklook.md). Every key is optional; an absent one
 // keeps the quick-look library's own default (processing/quicklook), so each parameter has its
 // default in one place. Ranges are [low, high] (green); amber bands stay the library's.
@@ -151,6 +151,19 @@ struct QuickLookConfig {
     std::optional<double> mlos_threshold;
     std::optional<int> ment_iterations;
   } preview;
+
+  // The spray quick-look's targets and settings (shadowgraphy rigs, docs/spray.md).
+  struct Spray {
+    std::optional<double> coverage_max;              // shadow coverage, fraction of the view
+    std::optional<double> uniformity_min;            // bright field p5 / p95
+    std::optional<double> energy_tolerance;          // LED pulse energy: green within 1 +- this
+    std::optional<std::array<double, 2>> bright_fraction;  // bright-field level, of full scale
+    std::optional<std::array<double, 2>> shadow_count;     // droplet shadows per frame
+    std::optional<double> min_intensity_max;         // the deepest shadow reaches at least this low
+    std::optional<int> binning;                      // working image: 0 automatic, 1..8
+    std::optional<double> shadow_sigmas;
+    std::optional<int> reference_sets;
+  } spray;
 };
 
 // [dashboard]: the operator's dashboard of `tomorig run --http` (docs/dashboard.md).

@@ -1,6 +1,6 @@
 #pragma once
 // What the quick-look stage runs with: the quick-look library's options (statistics, Δt check,
-// drift monitor, preview volume), each starting from the library's own default and overridden
+// drift monitor, preview volume, spray quick-look), each starting from the library's own default and overridden
 // by the rig file's [quicklook] keys (config::QuickLookConfig, docs/configuration.md), then by
 // the stage's own keys (`--stage quicklook:key=value`).
 #include <string>
@@ -11,6 +11,7 @@
 #include "tomorig/processing/quicklook/drift_monitor.h"
 #include "tomorig/processing/quicklook/dt_check.h"
 #include "tomorig/processing/quicklook/preview_volume.h"
+#include "tomorig/processing/quicklook/shadow_look.h"
 #include "tomorig/processing/quicklook/statistics.h"
 
 namespace tomorig::pipeline {
@@ -20,6 +21,7 @@ struct QuickLookSettings {
   quicklook::DtCheckOptions dt_check;
   quicklook::DriftOptions drift;
   quicklook::PreviewVolumeOptions preview;
+  quicklook::ShadowLookOptions shadow;  // the spray quick-look (shadow mode); bit_depth per camera
   bool preview_enabled = true;  // the preview volume and the drift monitor (they need cameras and a grid)
   bool store = true;            // quick-look numbers into the session file, when the recording has one
   std::string publish;          // PUB endpoint for the results; empty: none

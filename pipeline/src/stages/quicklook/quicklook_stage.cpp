@@ -101,7 +101,7 @@ class QuickLookStage final : public Stage {
       options.bit_depth = bit_depth(camera.pixel_format);
       statistics_.emplace_back(options);
       dt_checks_.emplace_back(settings.dt_check);
-      quicklook::ShadowLookOptions shadow;
+      quicklook::ShadowLookOptions shadow = settings.shadow;
       shadow.bit_depth = options.bit_depth;
       shadow_looks_.emplace_back(shadow);
       results_.push_back({.id = camera.id, .shadow = shadow_mode_});
