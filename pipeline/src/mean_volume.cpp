@@ -83,6 +83,9 @@ MeanVolumeReport write_mean_volume(const MeanVolumeOptions& o, const std::functi
   const VoxelGrid& grid = input.grid;
   MeanVolumeReport report;
   report.sets = (o.sets.empty() ? SetSelection() : SetSelection::parse(o.sets)).indices(session.set_count());
+  if (report.sets.empty())
+    throw bad_input(fmt::format("session '{}' has no sets{} to average: nothing was written", o.session.string(),
+                                o.sets.empty() ? "" : fmt::format(" in --sets {}", o.sets)));
   report.grid = grid;
   report.algorithm = setup.options.algorithm;
 

@@ -149,6 +149,11 @@ TEST_F(SprayProcess, TheMeanIntensityVolumeLiesWhereTheTruthsDropletsAre) {
                                         " -o " + shell_quoted(other.string()));
   EXPECT_EQ(one_set.exit_code, 2) << one_set.err;
   EXPECT_NE(one_set.err.find("--set does not apply"), std::string::npos) << one_set.err;
+  // An empty selection is refused, not averaged over nothing.
+  const CliResult none = run_tomorig("reconstruct " + shell_quoted(session.string()) + " --mean --sets 2:2" + grid +
+                                     " --psf truth -o " + shell_quoted(other.string()));
+  EXPECT_EQ(none.exit_code, 2) << none.err;
+  EXPECT_NE(none.err.find("the range is empty"), std::string::npos) << none.err;
   EXPECT_FALSE(fs::exists(other));
 }
 
