@@ -59,6 +59,7 @@ void report_counters(benchmark::State& state, const tomorig::piv::CorrelationOpt
     state.counters["ts_" + tag + "_peak"] = r.thread_seconds_peak;
     state.counters["direct_" + tag] = std::string(r.method) == "direct";
     state.counters["occupied_" + tag] = r.occupied_fraction;
+    state.counters["fallbacks_" + tag] = static_cast<double>(r.fft_fallbacks);
   }
   state.counters["valid_fraction"] = report.valid_fraction();
   const tomorig::piv::FftFloor floor = tomorig::piv::measure_fft_floor(thesis_pair().a.grid, options);

@@ -156,7 +156,11 @@ TEST(BenchPiv3dCli, ReducedTruthCaseMeetsTheNoiseFreeReferenceAndPrintsTheDocume
                   pass["seconds_validation"].get<double>(),
               pass["seconds"].get<double>() + 1e-6);
   }
-  EXPECT_EQ(passes[1]["method"], "fft");     // integer offset: displacements of several voxels
+  EXPECT_EQ(passes[0]["method"], "fft");     // the binned pass: no predictor, no pre-search
+  EXPECT_EQ(passes[1]["method"], "direct");  // integer offset: around the binned pre-search's peak
+  EXPECT_LT(passes[1]["fft_fallbacks"].get<double>(), 0.05 * passes[1]["nodes"][0].get<double>() *
+                                                          passes[1]["nodes"][1].get<double>() *
+                                                          passes[1]["nodes"][2].get<double>());
   EXPECT_EQ(passes[3]["method"], "direct");  // residual after deformation, sparse volumes
   EXPECT_LT(passes[3]["occupied_fraction"].get<double>(), 0.08);
 }

@@ -79,10 +79,18 @@ PassGeometry geometry_of(const CorrelationPass& pass, const VolumeView& level) {
 // gathers); a deterministic choice, so every process picks the same method.
 constexpr double kDirectMaxOccupancy = 0.08;
 
-bool use_direct(const CorrelationPass& pass, Int3 window, bool deform, double occupancy) {
-  if (!deform || pass.method == CorrelationMethod::fft) return false;
-  if (window.x < 8 || window.y < 8 || window.z < 8) return false;  // lags +-2 must not reach the wrap
+bool use_direct(const CorrelationPass& pass, double occupancy) {
   return pass.method == CorrelationMethod::direct || occupancy <= kDirectMaxOccupancy;
+}
+
+// Whether a pass can correlate directly at all: a deformation pass needs windows of 8 voxels
+// (its lags +-2 must not reach the wrap); a pass without deformation finds its lags by the
+// binned pre-search, so its windows must halve into windows of at least 8.
+bool direct_possible(const CorrelationPass& pass, const PassGeometry& g, bool deform) {
+  if (pass.method == CorrelationMethod::fft) return false;
+  if (deform) return g.window.x >= 8 && g.window.y >= 8 && g.window.z >= 8;
+  return g.factor == 1 && g.window.x % 2 == 0 && g.window.y % 2 == 0 && g.window.z % 2 == 0 && g.window.x >= 16 &&
+         g.window.y >= 16 && g.window.z >= 16;
 }
 
 bool same_grid(const VoxelGrid& a, const VoxelGrid& b) {
@@ -180,27 +188,42 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
     field.spacing = {double(g.factor * g.step.x), double(g.factor * g.step.y), double(g.factor * g.step.z)};
 
     const detail::FftCorrelator correlator(g.window, options.weighting, options.gaussian_sigma);
-    // Sparse direct correlation of the deformation passes: the occupied voxels listed once, in
-    // blocks of the window step that the overlapping windows share.
+    // Sparse direct correlation: the occupied voxels listed once, in blocks of the window step
+    // that the overlapping windows share. The deformation passes correlate at the lags around
+    // their predictor; the passes without deformation (the single pass, the integer-offset
+    // pass) at the lags around the peak of the same windows binned 2x (a pre-search by FFT at
+    // an eighth of the voxels), so they find the FFT's peak wherever the binned one finds it
+    // within a voxel or two.
     const detail::OccupiedVoxels& occupied_a = level.occupied_a;
     const detail::OccupiedVoxels& occupied_b = level.occupied_b;
     bool direct = false;
     // (Entries store 16-bit coordinates: larger volumes keep the FFT.)
     const bool listable = va.nx <= 65535 && va.ny <= 65535 && va.nz <= 65535;
     double seconds_listing = 0;
-    if (deform && listable && pass.method != CorrelationMethod::fft && g.window.x >= 8 && g.window.y >= 8 &&
-        g.window.z >= 8) {
+    if (listable && direct_possible(pass, g, deform)) {
       const auto start_listing = std::chrono::steady_clock::now();
-      detail::list_occupied(va, g.step, detail::kOccupiedThreshold, threads, level.occupied_a, true);
+      detail::list_occupied(va, g.step, detail::kOccupiedThreshold, threads, level.occupied_a, deform);
       detail::list_occupied(vb, g.step, detail::kOccupiedThreshold, threads, level.occupied_b, false);
       seconds_listing = seconds_since(start_listing);
       pr.occupied_fraction = 0.5 * (occupied_a.occupied_fraction + occupied_b.occupied_fraction);
-      direct = use_direct(pass, g.window, deform, pr.occupied_fraction);
+      direct = use_direct(pass, pr.occupied_fraction);
     }
     std::optional<detail::DirectCorrelator> direct_correlator;
     double seconds_lag_sums = 0;
-    if (direct) {
-      direct_correlator.emplace(g.window, options.weighting, options.gaussian_sigma);
+    if (direct) direct_correlator.emplace(g.window, options.weighting, options.gaussian_sigma);
+    // The pre-search's binned volumes and windows (passes without deformation).
+    std::optional<detail::FftCorrelator> coarse_correlator;
+    VolumeView coarse_a, coarse_b;
+    if (direct && !deform) {
+      const auto start_binning = std::chrono::steady_clock::now();
+      Level& coarse = level_for(2);
+      coarse_a = coarse.view_a;
+      coarse_b = coarse.view_b;
+      coarse_correlator.emplace(Int3{g.window.x / 2, g.window.y / 2, g.window.z / 2}, options.weighting,
+                                options.gaussian_sigma);
+      seconds_listing += seconds_since(start_binning);
+    }
+    if (direct && deform) {
       // Every window's lag sums at once, shared between the overlapping windows. (The windows
       // of a deformation pass start at node * step, all inside the volumes.)
       const auto start_sums = std::chrono::steady_clock::now();
@@ -209,7 +232,7 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
                               direct_correlator->weights_z(), threads, level.lag_sums);
       seconds_lag_sums = seconds_since(start_sums);
     }
-    const float* lag_sums = direct ? level.lag_sums.sums.data() : nullptr;
+    const float* lag_sums = direct && deform ? level.lag_sums.sums.data() : nullptr;
     pr.method = direct ? "direct" : "fft";
     const long long node_count = static_cast<long long>(field.count());
     std::size_t fallbacks = 0, empty = 0, fft_fallbacks = 0;
@@ -218,6 +241,8 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
     {
       auto scratch = correlator.make_scratch();  // once per thread and pass, never per window
       detail::DirectCorrelator::Scratch direct_scratch;
+      std::optional<detail::FftCorrelator::Scratch> coarse_scratch;
+      if (coarse_correlator) coarse_scratch = coarse_correlator->make_scratch();
 #pragma omp for schedule(dynamic, 4)
       for (long long n = 0; n < node_count; ++n) {
         const int i = static_cast<int>(n % g.nodes.x);
@@ -239,9 +264,25 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
         const Int3 start_b{start_a.x + offset.x, start_a.y + offset.y, start_a.z + offset.z};
         detail::WindowPeak peak;
         bool by_fft = !direct;
-        if (direct) {
+        if (direct && deform) {
           peak = direct_correlator->correlate_from_sums(lag_sums + n * detail::kLagSlots, occupied_a, vb, occupied_b,
                                                         start, direct_scratch, by_fft);
+          fft_fallbacks += by_fft;
+        } else if (direct) {
+          // The binned windows holding these (a binned voxel k holds voxels 2k and 2k + 1): a
+          // displacement D moves the binned particles D / 2, so the binned peak d says the
+          // full windows' peak lies near 2 d + 2 (sb - sa) - offset.
+          const Int3 sa{floor_half(start_a.x), floor_half(start_a.y), floor_half(start_a.z)};
+          const Int3 sb{floor_half(start_b.x), floor_half(start_b.y), floor_half(start_b.z)};
+          const detail::WindowPeak coarse = coarse_correlator->correlate(coarse_a, sa, coarse_b, sb, *coarse_scratch);
+          by_fft = !coarse.valid;
+          if (coarse.valid) {
+            const Int3 centre{static_cast<int>(std::lround(2.0 * coarse.dx + 2 * (sb.x - sa.x) - offset.x)),
+                              static_cast<int>(std::lround(2.0 * coarse.dy + 2 * (sb.y - sa.y) - offset.y)),
+                              static_cast<int>(std::lround(2.0 * coarse.dz + 2 * (sb.z - sa.z) - offset.z))};
+            peak = direct_correlator->correlate_around(occupied_a, occupied_b, vb, start_a, start_b, centre,
+                                                       direct_scratch, by_fft);
+          }
           fft_fallbacks += by_fft;
         }
         if (by_fft) peak = correlator.correlate(va, start_a, vb, start_b, scratch);
@@ -253,9 +294,10 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
         field.peak[n] = peak.peak;
         field.status[n] = VectorStatus::valid;
       }
-      load += scratch.seconds.load + direct_scratch.seconds.load;
-      correlation += scratch.seconds.correlation + direct_scratch.seconds.correlation;
-      peak_fit += scratch.seconds.peak + direct_scratch.seconds.peak;
+      const detail::StageSeconds coarse_seconds = coarse_scratch ? coarse_scratch->seconds : detail::StageSeconds{};
+      load += scratch.seconds.load + direct_scratch.seconds.load + coarse_seconds.load;
+      correlation += scratch.seconds.correlation + direct_scratch.seconds.correlation + coarse_seconds.correlation;
+      peak_fit += scratch.seconds.peak + direct_scratch.seconds.peak + coarse_seconds.peak;
     }
     pr.fft_fallbacks = fft_fallbacks;
     pr.seconds_windows = seconds_since(start_windows);

@@ -6,8 +6,8 @@
 #include <chrono>
 #include <cmath>
 
+#include "correlation/direct_peak.h"
 #include "correlation/window_lag_sums.h"
-#include "tomorig/processing/correlation/peak_fit.h"
 
 namespace tomorig::piv::detail {
 namespace {
@@ -24,12 +24,10 @@ void weight_autocorrelation(const std::vector<float>& w, double out[5]) {
   const int n = static_cast<int>(w.size());
   for (int d = -2; d <= 2; ++d) {
     double sum = 0;
-    for (int i = 0; i < n; ++i) sum += static_cast<double>(w[i]) * w[wrap(((i + d) % n + n) % n, n)];
+    for (int i = 0; i < n; ++i) sum += static_cast<double>(w[i]) * w[((i + d) % n + n) % n];
     out[d + 2] = sum;
   }
 }
-
-inline int lag_index(int dx, int dy, int dz) { return (dx + 1) + 3 * ((dy + 1) + 3 * (dz + 1)); }
 
 }  // namespace
 
@@ -149,6 +147,19 @@ DirectCorrelator::DirectCorrelator(Int3 window, WindowWeighting weighting, doubl
   px_ = padded(wx_);
   py_ = padded(wy_);
   pz_ = padded(wz_);
+  auto full_autocorrelation = [](const std::vector<float>& w) {
+    const int n = static_cast<int>(w.size());
+    std::vector<float> k(n);
+    for (int d = 0; d < n; ++d) {
+      double sum = 0;
+      for (int i = 0; i < n; ++i) sum += static_cast<double>(w[i]) * w[(i + d) % n];
+      k[d] = static_cast<float>(sum);
+    }
+    return k;
+  };
+  kx_full_ = full_autocorrelation(wx_);
+  ky_full_ = full_autocorrelation(wy_);
+  kz_full_ = full_autocorrelation(wz_);
   weight_autocorrelation(wx_, kx_);
   weight_autocorrelation(wy_, ky_);
   weight_autocorrelation(wz_, kz_);
@@ -248,63 +259,17 @@ WindowPeak DirectCorrelator::correlate_from_sums(const float* sums, const Occupi
   for (int dz = -1; dz <= 1; ++dz)
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
-        const int l = lag_index(dx, dy, dz);
+        const int l = direct_lag_index(dx, dy, dz);
         const double k = kx_[dx + 2] * ky_[dy + 2] * kz_[dz + 2];
         r[l] = p[l] - mean_b * sums[kSlotQA + l] - mean_a * sums[kSlotQB + l] + mean_a * mean_b * k;
       }
   const auto t2 = Clock::now();
   s.seconds.correlation += seconds_between(t1, t2);
 
-  int best = 0;
-  for (int l = 1; l < 27; ++l)
-    if (r[l] > r[best]) best = l;
-  const int m[3] = {best % 3 - 1, (best / 3) % 3 - 1, best / 9 - 1};
-  const double centre = r[best];
-  double left[3], right[3];
-  // The outer neighbours beyond the 27 lags (one per axis whose peak lag is +-1), all in one
-  // pass over the window's entries.
-  int outer[3][3];
-  int outer_axis[3];
-  int outer_count = 0;
-  for (int axis = 0; axis < 3; ++axis) {
-    int lo[3] = {m[0], m[1], m[2]}, hi[3] = {m[0], m[1], m[2]};
-    lo[axis] -= 1;
-    hi[axis] += 1;
-    if (lo[axis] >= -1) left[axis] = r[lag_index(lo[0], lo[1], lo[2])];
-    if (hi[axis] <= 1) right[axis] = r[lag_index(hi[0], hi[1], hi[2])];
-    if (lo[axis] < -1 || hi[axis] > 1) {
-      const int* lag = lo[axis] < -1 ? lo : hi;
-      outer[outer_count][0] = lag[0];
-      outer[outer_count][1] = lag[1];
-      outer[outer_count][2] = lag[2];
-      outer_axis[outer_count++] = axis;
-    }
-  }
-  if (outer_count > 0) {
-    double values[3];
-    outer_lags(oa, vb, ob, start, outer, outer_count, mean_a, mean_b, values);
-    for (int o = 0; o < outer_count; ++o) {
-      const int axis = outer_axis[o];
-      (outer[o][axis] < m[axis] ? left : right)[axis] = values[o];
-    }
-  }
-  for (int axis = 0; axis < 3; ++axis)
-    if (left[axis] > centre || right[axis] > centre) {  // the peak continues beyond: FFT
-      fallback = true;
-      s.seconds.peak += seconds_between(t2, Clock::now());
-      return result;
-    }
-  float offsets[3];
-  for (int axis = 0; axis < 3; ++axis) {
-    const PeakFit1d fit = fit_peak_1d(left[axis], centre, right[axis], true, true);
-    if (fit.method != PeakFitMethod::gaussian) ++result.fallbacks;
-    offsets[axis] = static_cast<float>(m[axis] + fit.offset);
-  }
-  result.dx = offsets[0];
-  result.dy = offsets[1];
-  result.dz = offsets[2];
-  result.peak = static_cast<float>(centre / std::sqrt(energy_a * energy_b));
-  result.valid = true;
+  result = direct_peak<1>(
+      r, energy_a, energy_b,
+      [&](const int (*lags)[3], int count, double* out) { outer_lags(oa, vb, ob, start, lags, count, mean_a, mean_b, out); },
+      fallback);
   s.seconds.peak += seconds_between(t2, Clock::now());
   return result;
 }

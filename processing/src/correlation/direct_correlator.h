@@ -58,6 +58,13 @@ class DirectCorrelator {
 
   struct Scratch {
     StageSeconds seconds;
+    // correlate_around's window entries (window coordinates) and per-axis tables, memory
+    // reused per thread.
+    std::vector<OccupiedVoxels::Entry> window_a, window_b;
+    struct AxisTables {
+      std::vector<float> plus, minus;
+      std::vector<int> b;
+    } axes[3];
   };
 
   // The same window from its contracted sums (window_lag_sums.h: `sums` its kLagSlots floats)
@@ -67,6 +74,15 @@ class DirectCorrelator {
   // this window by FFT.
   WindowPeak correlate_from_sums(const float* sums, const OccupiedVoxels& oa, const VolumeView& vb,
                                  const OccupiedVoxels& ob, Int3 start, Scratch& scratch, bool& fallback) const;
+
+  // A pass without deformation (the windows of a and b start at start_a and start_b, which may
+  // differ by an integer offset): Eq. 2.16 at the 27 lags around `centre` (a lag of the FFT's
+  // plane, from the binned pre-search) and the peak's outer neighbours, from the windows' own
+  // entries (at 50 % overlap each voxel lies in 8 windows: nothing worth sharing). The peak's
+  // lag is absolute (centre included). Voxels outside a volume count as 0, as for the FFT;
+  // `fallback` as for correlate_from_sums, and also when the lags would reach the plane's wrap.
+  WindowPeak correlate_around(const OccupiedVoxels& oa, const OccupiedVoxels& ob, const VolumeView& vb, Int3 start_a,
+                              Int3 start_b, Int3 centre, Scratch& scratch, bool& fallback) const;
 
   const std::vector<float>& weights_x() const { return wx_; }
   const std::vector<float>& weights_y() const { return wy_; }
@@ -81,6 +97,8 @@ class DirectCorrelator {
   double weight_energy_ = 0;             // sum of w^2 over the window
   // Circular autocorrelation of the weights per axis, K(d) for d = -2..2 at index d + 2.
   double kx_[5], ky_[5], kz_[5];
+  // The same at every lag 0 .. W - 1 (circular), for correlate_around's centres.
+  std::vector<float> kx_full_, ky_full_, kz_full_;
 
   // Adds the wrapped lag products of one shell entry (window coordinates i, j, k) into p4.
   void add_shell_entry(const OccupiedVoxels::Entry& v, int i, int j, int k, Int3 start, const VolumeView& vb,

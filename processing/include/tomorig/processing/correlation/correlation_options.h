@@ -11,9 +11,10 @@ namespace tomorig::piv {
 
 enum class WindowWeighting { top_hat, gaussian, hann };
 enum class Interpolation { trilinear, cubic_bspline };
-// How a deformation pass correlates its windows: `automatic` chooses sparse direct correlation
-// (lags -1..1 around the predictor) when the deformed volumes are sparse enough for it to cost
-// less than the FFTs, else FFT; passes without deformation always use the FFT.
+// How a pass with a predictor (the integer-offset pass and the deformation passes) correlates
+// its windows: `automatic` chooses sparse direct correlation (lags -1..1 around the predictor,
+// the FFT for a window whose peak lies beyond them) when the volumes are sparse enough for it
+// to cost less than the FFTs, else FFT; the first pass, without a predictor, always uses the FFT.
 enum class CorrelationMethod { automatic, fft, direct };
 
 struct WindowSize {
