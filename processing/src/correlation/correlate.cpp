@@ -36,6 +36,7 @@ struct Level {
   std::vector<std::uint8_t> support_scratch;
   detail::OccupiedVoxels occupied_a, occupied_b;   // of the deformed pair, memory reused by each pass
   detail::WindowLagSums lag_sums;                  // a direct pass's per-window sums, memory reused
+  detail::FaceProducts face_products;              // a direct pass's shell products, memory reused
 };
 
 // The buffers of a correlation, kept by the calling thread from one correlation to the next
@@ -230,8 +231,15 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
       detail::window_lag_sums(occupied_a, vb, occupied_b, g.window, g.step, g.nodes,
                               direct_correlator->weights_x(), direct_correlator->weights_y(),
                               direct_correlator->weights_z(), threads, level.lag_sums);
+      // Windows on block borders share their faces' wrapped products (shell_products.cpp).
+      if (g.window.x % g.step.x == 0 && g.window.y % g.step.y == 0 && g.window.z % g.step.z == 0)
+        detail::face_products(occupied_a, vb, g.window, threads, level.face_products);
       seconds_lag_sums = seconds_since(start_sums);
     }
+    const detail::FaceProducts* face_products =
+        direct && deform && g.window.x % g.step.x == 0 && g.window.y % g.step.y == 0 && g.window.z % g.step.z == 0
+            ? &level.face_products
+            : nullptr;
     const float* lag_sums = direct && deform ? level.lag_sums.sums.data() : nullptr;
     pr.method = direct ? "direct" : "fft";
     const long long node_count = static_cast<long long>(field.count());
@@ -266,7 +274,7 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
         bool by_fft = !direct;
         if (direct && deform) {
           peak = direct_correlator->correlate_from_sums(lag_sums + n * detail::kLagSlots, occupied_a, vb, occupied_b,
-                                                        start, direct_scratch, by_fft);
+                                                        start, direct_scratch, by_fft, face_products);
           fft_fallbacks += by_fft;
         } else if (direct) {
           // The binned windows holding these (a binned voxel k holds voxels 2k and 2k + 1): a

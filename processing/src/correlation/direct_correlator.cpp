@@ -167,7 +167,7 @@ DirectCorrelator::DirectCorrelator(Int3 window, WindowWeighting weighting, doubl
 
 WindowPeak DirectCorrelator::correlate_from_sums(const float* sums, const OccupiedVoxels& oa, const VolumeView& vb,
                                                  const OccupiedVoxels& ob, Int3 start, Scratch& s,
-                                                 bool& fallback) const {
+                                                 bool& fallback, const FaceProducts* faces) const {
   fallback = false;
   WindowPeak result;
   const auto t0 = Clock::now();
@@ -208,6 +208,9 @@ WindowPeak DirectCorrelator::correlate_from_sums(const float* sums, const Occupi
       lo[axis] = hi[axis] = high ? hi[axis] : lo[axis];
       const std::vector<std::size_t>& fo = oa.face_offsets[f];
       const OccupiedVoxels::Entry* fe = oa.face_entries[f].data();
+      const float* fp = faces ? faces->values[f].data() : nullptr;
+      // The wrapped lag along `axis` and the padded weight tables of the other two axes.
+      const int u = axis == 0 ? 1 : 0, v_axis = axis == 2 ? 1 : 2;
       for (int bz = lo[2]; bz <= hi[2]; ++bz)
         for (int by = lo[1]; by <= hi[1]; ++by)
           for (int bx = lo[0]; bx <= hi[0]; ++bx) {
@@ -217,7 +220,28 @@ WindowPeak DirectCorrelator::correlate_from_sums(const float* sums, const Occupi
               const int i = v.x - start.x, j = v.y - start.y, k = v.z - start.z;
               if (axis >= 1 && (i == 0 || i == w.x - 1)) continue;  // taken from an x face
               if (axis == 2 && (j == 0 || j == w.y - 1)) continue;  // taken from a y face
-              add_shell_entry(v, i, j, k, start, vb, inside, p4);
+              // On this face only (not on an edge of the window): its 9 wrapped products were
+              // made once for every window sharing the face.
+              const bool edge = (axis == 0 && (j == 0 || j == w.y - 1 || k == 0 || k == w.z - 1)) ||
+                                (axis == 1 && (k == 0 || k == w.z - 1));
+              if (!fp || edge) {
+                add_shell_entry(v, i, j, k, start, vb, inside, p4);
+                continue;
+              }
+              const int c[3] = {i, j, k};
+              const float* pad[3] = {px_.data() + 2, py_.data() + 2, pz_.data() + 2};
+              const float wa = wx_[i] * wy_[j] * wz_[k] * pad[axis][c[axis] + (high ? 1 : -1)];
+              const float* product = fp + e * kFaceSlots;
+              const int wrapped_slot = high ? 2 : 0;  // the lag index along `axis`
+              for (int dv = 0; dv < 3; ++dv)
+                for (int du = 0; du < 3; ++du) {
+                  const float weight = wa * pad[u][c[u] + du - 1] * pad[v_axis][c[v_axis] + dv - 1];
+                  int lag[3];
+                  lag[axis] = wrapped_slot;
+                  lag[u] = du;
+                  lag[v_axis] = dv;
+                  p4[lag[1] + 3 * lag[2]][lag[0]] += weight * product[du + 3 * dv];
+                }
             }
           }
     }

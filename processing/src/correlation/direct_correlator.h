@@ -52,6 +52,17 @@ void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, in
 // The fraction of a volume's largest magnitude below which a voxel counts as empty.
 inline constexpr float kOccupiedThreshold = 1e-3f;
 
+// Per face list of OccupiedVoxels (same order), kFaceSlots products per entry: the entry's
+// value times b at its partner across a window of `window` voxels (the FFT's circular lag over
+// that face), at the 3 x 3 lags of the two other axes (slot (du + 1) + 3 (dv + 1), u before v
+// in x, y, z order); 0 where the partner lies outside b.
+inline constexpr int kFaceSlots = 9;
+struct FaceProducts {
+  Int3 window;
+  std::vector<float> values[6];
+};
+void face_products(const OccupiedVoxels& oa, const VolumeView& vb, Int3 window, int threads, FaceProducts& out);
+
 class DirectCorrelator {
  public:
   DirectCorrelator(Int3 window, WindowWeighting weighting, double gaussian_sigma);
@@ -72,8 +83,11 @@ class DirectCorrelator {
   // the peak's outer neighbours beyond +-1, when needed, from the window's entries. `fallback`
   // is false when the peak lies within the lags searched; otherwise the caller correlates
   // this window by FFT.
+  // `faces` (of oa and vb for this window size), where given, supply the shell's products of
+  // the entries on one window face only, for windows on block borders.
   WindowPeak correlate_from_sums(const float* sums, const OccupiedVoxels& oa, const VolumeView& vb,
-                                 const OccupiedVoxels& ob, Int3 start, Scratch& scratch, bool& fallback) const;
+                                 const OccupiedVoxels& ob, Int3 start, Scratch& scratch, bool& fallback,
+                                 const FaceProducts* faces = nullptr) const;
 
   // A pass without deformation (the windows of a and b start at start_a and start_b, which may
   // differ by an integer offset): Eq. 2.16 at the 27 lags around `centre` (a lag of the FFT's
