@@ -209,8 +209,14 @@ WindowPeak DirectCorrelator::correlate_from_sums(const float* sums, const Occupi
       const std::vector<std::size_t>& fo = oa.face_offsets[f];
       const OccupiedVoxels::Entry* fe = oa.face_entries[f].data();
       const float* fp = faces ? faces->values[f].data() : nullptr;
-      // The wrapped lag along `axis` and the padded weight tables of the other two axes.
+      // The other two axes (u before v), and where a face product's lag (du, dv) goes in p4
+      // (float[9][4], row dy + 3 dz, lane dx): base + su du + sv dv.
       const int u = axis == 0 ? 1 : 0, v_axis = axis == 2 ? 1 : 2;
+      const int wrapped_slot = high ? 2 : 0;  // the lag index along `axis`
+      const int base = axis == 0 ? wrapped_slot : (axis == 1 ? 4 * wrapped_slot : 12 * wrapped_slot);
+      const int su = axis == 0 ? 4 : 1, sv = axis == 2 ? 4 : 12;
+      const float* pad[3] = {px_.data() + 2, py_.data() + 2, pz_.data() + 2};
+      float* p4_flat = &p4[0][0];
       for (int bz = lo[2]; bz <= hi[2]; ++bz)
         for (int by = lo[1]; by <= hi[1]; ++by)
           for (int bx = lo[0]; bx <= hi[0]; ++bx) {
@@ -229,19 +235,15 @@ WindowPeak DirectCorrelator::correlate_from_sums(const float* sums, const Occupi
                 continue;
               }
               const int c[3] = {i, j, k};
-              const float* pad[3] = {px_.data() + 2, py_.data() + 2, pz_.data() + 2};
               const float wa = wx_[i] * wy_[j] * wz_[k] * pad[axis][c[axis] + (high ? 1 : -1)];
               const float* product = fp + e * kFaceSlots;
-              const int wrapped_slot = high ? 2 : 0;  // the lag index along `axis`
-              for (int dv = 0; dv < 3; ++dv)
-                for (int du = 0; du < 3; ++du) {
-                  const float weight = wa * pad[u][c[u] + du - 1] * pad[v_axis][c[v_axis] + dv - 1];
-                  int lag[3];
-                  lag[axis] = wrapped_slot;
-                  lag[u] = du;
-                  lag[v_axis] = dv;
-                  p4[lag[1] + 3 * lag[2]][lag[0]] += weight * product[du + 3 * dv];
-                }
+              const float* wu = pad[u] + c[u] - 1;
+              const float* wv = pad[v_axis] + c[v_axis] - 1;
+              for (int dv = 0; dv < 3; ++dv) {
+                const float row = wa * wv[dv];
+                float* out = p4_flat + base + sv * dv;
+                for (int du = 0; du < 3; ++du) out[su * du] += row * wu[du] * product[du + 3 * dv];
+              }
             }
           }
     }
