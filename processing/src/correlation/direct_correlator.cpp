@@ -338,25 +338,7 @@ void DirectCorrelator::outer_lags(const OccupiedVoxels& oa, const VolumeView& vb
                                   const int lags[][3], int count, double mean_a, double mean_b, double* out) const {
   const Int3 w = window_;
   double ps[3] = {}, qas[3] = {}, qbs[3] = {};
-  auto for_entries = [&](const OccupiedVoxels& o, auto&& f) {
-    const int bx0 = std::max(0, start.x) / o.block.x, bx1 = std::min(o.blocks.x - 1, (start.x + w.x - 1) / o.block.x);
-    const int by0 = std::max(0, start.y) / o.block.y, by1 = std::min(o.blocks.y - 1, (start.y + w.y - 1) / o.block.y);
-    const int bz0 = std::max(0, start.z) / o.block.z, bz1 = std::min(o.blocks.z - 1, (start.z + w.z - 1) / o.block.z);
-    for (int bz = bz0; bz <= bz1; ++bz)
-      for (int by = by0; by <= by1; ++by)
-        for (int bx = bx0; bx <= bx1; ++bx) {
-          const std::size_t b = bx + static_cast<std::size_t>(o.blocks.x) * (by + static_cast<std::size_t>(o.blocks.y) * bz);
-          for (std::size_t e = o.offsets[b]; e < o.offsets[b + 1]; ++e) {
-            const OccupiedVoxels::Entry& v = o.entries[e];
-            const int i = v.x - start.x, j = v.y - start.y, k = v.z - start.z;
-            if (static_cast<unsigned>(i) >= static_cast<unsigned>(w.x) ||
-                static_cast<unsigned>(j) >= static_cast<unsigned>(w.y) ||
-                static_cast<unsigned>(k) >= static_cast<unsigned>(w.z))
-              continue;
-            f(i, j, k, v.value);
-          }
-        }
-  };
+  auto for_entries = [&](const OccupiedVoxels& o, auto&& f) { for_each_in_window(o, start, w, f); };
   const bool inside = start.x >= 0 && start.y >= 0 && start.z >= 0 && start.x + w.x <= vb.nx &&
                       start.y + w.y <= vb.ny && start.z + w.z <= vb.nz;
   auto b_at = [&](int i, int j, int k) -> float {

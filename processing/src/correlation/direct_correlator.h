@@ -49,6 +49,32 @@ struct OccupiedVoxels {
 void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, int threads, OccupiedVoxels& out,
                    bool faces);
 
+// Calls f(i, j, k, value) for every entry of `o` inside the window of `w` voxels at `start`
+// (i, j, k in window coordinates), visiting only the blocks the window touches.
+template <class F>
+void for_each_in_window(const OccupiedVoxels& o, Int3 start, Int3 w, F&& f) {
+  if (start.x + w.x <= 0 || start.y + w.y <= 0 || start.z + w.z <= 0) return;
+  auto first_block = [](int s, int size) { return s <= 0 ? 0 : s / size; };
+  auto last_block = [](int s, int size, int blocks) { return s / size < blocks - 1 ? s / size : blocks - 1; };
+  const int bx0 = first_block(start.x, o.block.x), bx1 = last_block(start.x + w.x - 1, o.block.x, o.blocks.x);
+  const int by0 = first_block(start.y, o.block.y), by1 = last_block(start.y + w.y - 1, o.block.y, o.blocks.y);
+  const int bz0 = first_block(start.z, o.block.z), bz1 = last_block(start.z + w.z - 1, o.block.z, o.blocks.z);
+  for (int bz = bz0; bz <= bz1; ++bz)
+    for (int by = by0; by <= by1; ++by)
+      for (int bx = bx0; bx <= bx1; ++bx) {
+        const std::size_t b = bx + static_cast<std::size_t>(o.blocks.x) * (by + static_cast<std::size_t>(o.blocks.y) * bz);
+        for (std::size_t e = o.offsets[b]; e < o.offsets[b + 1]; ++e) {
+          const OccupiedVoxels::Entry& v = o.entries[e];
+          const int i = v.x - start.x, j = v.y - start.y, k = v.z - start.z;
+          // (Unsigned: one test each for below 0 and beyond the window.)
+          if (static_cast<unsigned>(i) >= static_cast<unsigned>(w.x) ||
+              static_cast<unsigned>(j) >= static_cast<unsigned>(w.y) || static_cast<unsigned>(k) >= static_cast<unsigned>(w.z))
+            continue;
+          f(i, j, k, v.value);
+        }
+      }
+}
+
 // The fraction of a volume's largest magnitude below which a voxel counts as empty.
 inline constexpr float kOccupiedThreshold = 1e-3f;
 

@@ -17,28 +17,12 @@ double seconds_between(Clock::time_point a, Clock::time_point b) { return std::c
 
 int wrap(int i, int n) { return i < 0 ? i + n : (i >= n ? i - n : i); }
 
-// The entries of `o` inside the window at `start` (window coordinates), appended to `out`.
+// The entries of `o` inside the window at `start` (window coordinates), into `out`.
 void gather_window(const OccupiedVoxels& o, Int3 start, Int3 w, std::vector<OccupiedVoxels::Entry>& out) {
   out.clear();
-  auto first_block = [](int s, int size) { return s <= 0 ? 0 : s / size; };
-  const int bx0 = first_block(start.x, o.block.x), bx1 = std::min(o.blocks.x - 1, (start.x + w.x - 1) / o.block.x);
-  const int by0 = first_block(start.y, o.block.y), by1 = std::min(o.blocks.y - 1, (start.y + w.y - 1) / o.block.y);
-  const int bz0 = first_block(start.z, o.block.z), bz1 = std::min(o.blocks.z - 1, (start.z + w.z - 1) / o.block.z);
-  if (start.x + w.x <= 0 || start.y + w.y <= 0 || start.z + w.z <= 0) return;
-  for (int bz = bz0; bz <= bz1; ++bz)
-    for (int by = by0; by <= by1; ++by)
-      for (int bx = bx0; bx <= bx1; ++bx) {
-        const std::size_t b = bx + static_cast<std::size_t>(o.blocks.x) * (by + static_cast<std::size_t>(o.blocks.y) * bz);
-        for (std::size_t e = o.offsets[b]; e < o.offsets[b + 1]; ++e) {
-          const OccupiedVoxels::Entry& v = o.entries[e];
-          const int i = v.x - start.x, j = v.y - start.y, k = v.z - start.z;
-          if (static_cast<unsigned>(i) >= static_cast<unsigned>(w.x) ||
-              static_cast<unsigned>(j) >= static_cast<unsigned>(w.y) ||
-              static_cast<unsigned>(k) >= static_cast<unsigned>(w.z))
-            continue;
-          out.push_back({static_cast<std::uint16_t>(i), static_cast<std::uint16_t>(j), static_cast<std::uint16_t>(k), v.value});
-        }
-      }
+  for_each_in_window(o, start, w, [&](int i, int j, int k, float value) {
+    out.push_back({static_cast<std::uint16_t>(i), static_cast<std::uint16_t>(j), static_cast<std::uint16_t>(k), value});
+  });
 }
 
 }  // namespace
