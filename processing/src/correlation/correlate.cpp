@@ -101,6 +101,13 @@ bool same_grid(const VoxelGrid& a, const VoxelGrid& b) {
 
 int floor_half(int v) { return static_cast<int>(std::floor(v / 2.0)); }
 
+// `sparse` as a dense volume in `out`, reusing out's memory.
+void densify(const SparseVolume& sparse, DenseVolume& out) {
+  out.grid = sparse.grid;
+  out.values.assign(sparse.grid.voxel_count(), 0.0f);
+  for (std::size_t n = 0; n < sparse.index.size(); ++n) out.values[sparse.index[n]] = sparse.intensity[n];
+}
+
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -370,7 +377,14 @@ VectorField correlate(const SparseVolume& a, const SparseVolume& b, const Correl
                                 "reconstruct both exposures on the same grid",
                                 a.grid.nx, a.grid.ny, a.grid.nz, b.grid.nx, b.grid.ny, b.grid.nz));
   options.validate(a.grid);
-  return correlate(a.to_dense(), b.to_dense(), options, report);
+  // The dense pair in buffers the calling thread keeps between correlations (the back-end
+  // correlates every set on one thread): two fresh volumes of hundreds of megabytes per set
+  // cost their page faults and the kernel's zeroing every time (6.8 % of `tomorig process`'s CPU
+  // samples); a kept buffer is only cleared.
+  thread_local DenseVolume dense_a, dense_b;
+  densify(a, dense_a);
+  densify(b, dense_b);
+  return correlate(dense_a, dense_b, options, report);
 }
 
 FftFloor measure_fft_floor(const VoxelGrid& grid, const CorrelationOptions& options) {
