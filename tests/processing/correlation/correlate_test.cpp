@@ -437,6 +437,15 @@ TEST(Correlate, DirectPassesOffTheBlockBordersMatchTheFftPasses) {
   expect_direct_matches_fft({18, 18, 18}, WindowWeighting::gaussian, "Gaussian, 18^3 windows off the block borders");
 }
 
+// Nodes where two fields of the same geometry differ at all (status or any displacement bit).
+std::size_t nodes_differing(const VectorField& a, const VectorField& b) {
+  std::size_t differing = 0;
+  for (std::size_t n = 0; n < a.count(); ++n)
+    differing += a.status[n] != b.status[n] || a.displacement[n].x != b.displacement[n].x ||
+                 a.displacement[n].y != b.displacement[n].y || a.displacement[n].z != b.displacement[n].z;
+  return differing;
+}
+
 // The volume buffers (coefficients, deformed pair, masks, occupied lists) are kept by the
 // calling thread from one correlation to the next: a correlation after another of a different
 // pair (other volumes, other grid, other binning) must give exactly what the same correlation
@@ -462,11 +471,7 @@ TEST(Correlate, KeptBuffersCarryNothingIntoTheNextCorrelation) {
   (void)correlate(pair.b, pair.a, options, report);  // same grid, the volumes swapped
   const VectorField again = correlate(pair.a, pair.b, options, report);
   ASSERT_EQ(again.count(), fresh.count());
-  std::size_t differing = 0;
-  for (std::size_t n = 0; n < fresh.count(); ++n)
-    differing += again.status[n] != fresh.status[n] || again.displacement[n].x != fresh.displacement[n].x ||
-                 again.displacement[n].y != fresh.displacement[n].y || again.displacement[n].z != fresh.displacement[n].z;
-  EXPECT_EQ(differing, 0u);
+  EXPECT_EQ(nodes_differing(again, fresh), 0u);
   EXPECT_STREQ(report.passes.back().method, "direct");
 }
 
@@ -501,9 +506,5 @@ TEST(Correlate, SparseVolumesCorrelateAsTheirDenseFormAfterAnotherPair) {
   (void)correlate(sparse_of(other.a), sparse_of(other.b), options, report);
   const VectorField sparse = correlate(sparse_of(pair.a), sparse_of(pair.b), options, report);
   ASSERT_EQ(sparse.count(), dense.count());
-  std::size_t differing = 0;
-  for (std::size_t n = 0; n < dense.count(); ++n)
-    differing += sparse.status[n] != dense.status[n] || sparse.displacement[n].x != dense.displacement[n].x ||
-                 sparse.displacement[n].y != dense.displacement[n].y || sparse.displacement[n].z != dense.displacement[n].z;
-  EXPECT_EQ(differing, 0u);
+  EXPECT_EQ(nodes_differing(sparse, dense), 0u);
 }
