@@ -14,6 +14,7 @@
 #include "tomorig/pipeline/report_json.h"
 #include "json_summary.h"
 #include "tomorig/core/cli_vocabulary.h"
+#include "tomorig/pipeline/exposure_images.h"
 #include "tomorig/pipeline/mean_volume.h"
 #include "tomorig/pipeline/session_geometry.h"
 #include "tomorig/pipeline/session_preprocessor.h"
@@ -66,19 +67,6 @@ std::vector<Exposure> exposures_of(const std::string& name) {
 }
 
 // The images of one exposure in session camera order; a missing frame cannot be reconstructed.
-std::vector<Image> exposure_images(const FrameSet& set, Exposure e, const std::string& session, std::uint64_t index) {
-  std::vector<Image> images;
-  for (const CameraFrames& c : set.cameras) {
-    const Frame& f = c[e];
-    if (!f.present())
-      throw bad_input(fmt::format("session '{}' set {}: frame {} of camera {} is missing, so this exposure cannot "
-                                  "be reconstructed; choose another set",
-                                  session, index, e == Exposure::A ? "A" : "B", c.camera_id));
-    images.push_back(f.image);
-  }
-  return images;
-}
-
 void run_mean(const ReconstructArgs& args) {
   if (args.set_opt->count()) throw bad_input("--mean averages the sets of --sets (default all): --set does not apply");
   if (!args.png.empty()) throw bad_input("--png draws one set's depth profile; with --mean use --slices FOLDER");
@@ -153,7 +141,8 @@ void run(const ReconstructArgs& args) {
   std::vector<quality::DepthCurve> depth_curves;
   for (const Exposure e : exposures_of(args.exposure)) {
     const std::string name = e == Exposure::A ? "a" : "b";
-    input.images = exposure_images(set, e, args.session, args.set);
+    input.images = pipeline::exposure_images(set, e, args.session, args.set,
+                                             "this exposure cannot be reconstructed: choose another set");
     fmt::print(stderr, "reconstructing set {} exposure {} with {} on a {} x {} x {} grid...\n", args.set,
                e == Exposure::A ? "A" : "B", options.algorithm, input.grid.nx, input.grid.ny, input.grid.nz);
     recon::ReconstructionReport report;

@@ -8,6 +8,7 @@
 
 #include "tomorig/core/error.h"
 #include "tomorig/core/set_selection.h"
+#include "tomorig/pipeline/exposure_images.h"
 #include "tomorig/pipeline/report_json.h"
 #include "tomorig/pipeline/session_preprocessor.h"
 #include "tomorig/processing/reconstruction/reconstructor.h"
@@ -121,14 +122,8 @@ MeanVolumeReport write_mean_volume(const MeanVolumeOptions& o, const std::functi
     FrameSet set = session.read_set(k);
     preprocessor.apply(set);
     for (const Exposure e : o.exposures) {
-      input.images.clear();
-      for (const CameraFrames& c : set.cameras) {
-        if (!c[e].present())
-          throw bad_input(fmt::format("session '{}' set {}: frame {} of camera {} is missing; leave the set out with "
-                                      "--sets or average one exposure with --exposure",
-                                      o.session.string(), k, e == Exposure::A ? "A" : "B", c.camera_id));
-        input.images.push_back(c[e].image);
-      }
+      input.images = exposure_images(set, e, o.session.string(), k,
+                                     "leave the set out with --sets or average one exposure with --exposure");
       recon::ReconstructionReport rr;
       SparseVolume v = reconstructor->reconstruct(input, rr);
       if (!o.smooth.empty()) v = recon::gaussian_smooth(v, {o.smooth[0], o.smooth[1], o.smooth[2]}, o.recon.options.threads);

@@ -6,6 +6,7 @@
 
 #include "tomorig/core/error.h"
 #include "tomorig/pipeline/correlation_args.h"
+#include "tomorig/pipeline/exposure_images.h"
 #include "tomorig/pipeline/report_json.h"
 #include "tomorig/processing/reconstruction/smoothing.h"
 
@@ -70,15 +71,7 @@ ReconstructedSet PairProcessor::reconstruct(const FrameSet& set, std::uint64_t i
   r.started = Clock::now();
   recon::ReconstructionInput in = setup_.input;
   for (const Exposure e : {Exposure::A, Exposure::B}) {
-    in.images.clear();
-    for (const CameraFrames& c : set.cameras) {
-      const Frame& f = c[e];
-      if (!f.present())
-        throw bad_input(fmt::format("session '{}' set {}: frame {} of camera {} is missing; process the other sets "
-                                    "with --sets or repair the recording",
-                                    name_, index, e == Exposure::A ? "A" : "B", c.camera_id));
-      in.images.push_back(f.image);
-    }
+    in.images = exposure_images(set, e, name_, index, "process the other sets with --sets or repair the recording");
     if (exposure_started) exposure_started(e == Exposure::A ? 'A' : 'B');
     recon::ReconstructionReport report;
     SparseVolume v = reconstructor_->reconstruct(in, report);
