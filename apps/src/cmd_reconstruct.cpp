@@ -66,7 +66,6 @@ std::vector<Exposure> exposures_of(const std::string& name) {
   return {Exposure::A, Exposure::B};
 }
 
-// The images of one exposure in session camera order; a missing frame cannot be reconstructed.
 void run_mean(const ReconstructArgs& args) {
   if (args.set_opt->count()) throw bad_input("--mean averages the sets of --sets (default all): --set does not apply");
   if (!args.png.empty()) throw bad_input("--png draws one set's depth profile; with --mean use --slices FOLDER");

@@ -231,6 +231,9 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
                                 options.gaussian_sigma);
       seconds_listing += seconds_since(start_binning);
     }
+    // Windows on block borders share their faces' wrapped products (shell_products.cpp).
+    const bool shared_faces =
+        direct && deform && g.window.x % g.step.x == 0 && g.window.y % g.step.y == 0 && g.window.z % g.step.z == 0;
     if (direct && deform) {
       // Every window's lag sums at once, shared between the overlapping windows. (The windows
       // of a deformation pass start at node * step, all inside the volumes.)
@@ -238,15 +241,10 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
       detail::window_lag_sums(occupied_a, vb, occupied_b, g.window, g.step, g.nodes,
                               direct_correlator->weights_x(), direct_correlator->weights_y(),
                               direct_correlator->weights_z(), threads, level.lag_sums);
-      // Windows on block borders share their faces' wrapped products (shell_products.cpp).
-      if (g.window.x % g.step.x == 0 && g.window.y % g.step.y == 0 && g.window.z % g.step.z == 0)
-        detail::face_products(occupied_a, vb, g.window, threads, level.face_products);
+      if (shared_faces) detail::face_products(occupied_a, vb, g.window, threads, level.face_products);
       seconds_lag_sums = seconds_since(start_sums);
     }
-    const detail::FaceProducts* face_products =
-        direct && deform && g.window.x % g.step.x == 0 && g.window.y % g.step.y == 0 && g.window.z % g.step.z == 0
-            ? &level.face_products
-            : nullptr;
+    const detail::FaceProducts* face_products = shared_faces ? &level.face_products : nullptr;
     const float* lag_sums = direct && deform ? level.lag_sums.sums.data() : nullptr;
     pr.method = direct ? "direct" : "fft";
     const long long node_count = static_cast<long long>(field.count());

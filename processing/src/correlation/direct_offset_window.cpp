@@ -15,8 +15,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
-int wrap(int i, int n) { return i < 0 ? i + n : (i >= n ? i - n : i); }
-
 // The entries of `o` inside the window at `start` (window coordinates), into `out`.
 void gather_window(const OccupiedVoxels& o, Int3 start, Int3 w, std::vector<OccupiedVoxels::Entry>& out) {
   out.clear();
@@ -167,37 +165,32 @@ WindowPeak DirectCorrelator::correlate_around(const OccupiedVoxels& oa, const Oc
   const auto t2 = Clock::now();
   s.seconds.correlation += seconds_between(t1, t2);
 
-  // The outer neighbours (relative lags +-2), from the same entries.
+  // The outer neighbours (relative lags +-2), from the same entries and the same tables (they
+  // cover window positions -2 .. W + 1 around the centre).
   auto outer = [&](const int (*lags)[3], int count, double* out) {
     double ps[3] = {}, qas[3] = {}, qbs[3] = {};
     auto b_at = [&](int x, int y, int z) -> float {
       if (!inside && (x < 0 || y < 0 || z < 0 || x >= vb.nx || y >= vb.ny || z >= vb.nz)) return 0.0f;
       return vb.data[vb.linear(x, y, z)];
     };
-    int abs_lag[3][3];
-    for (int o = 0; o < count; ++o) {
-      abs_lag[o][0] = centre.x + lags[o][0];
-      abs_lag[o][1] = centre.y + lags[o][1];
-      abs_lag[o][2] = centre.z + lags[o][2];
-    }
     for (const auto& e : s.window_a) {
       const float wa = e.value * wx_[e.x] * wy_[e.y] * wz_[e.z];
       for (int o = 0; o < count; ++o) {
-        const int di = e.x + abs_lag[o][0], dj = e.y + abs_lag[o][1], dk = e.z + abs_lag[o][2];
-        const float f = wa * at(wx_, di) * at(wy_, dj) * at(wz_, dk);
-        ps[o] += f * b_at(start_b.x + wrapped(di, w.x), start_b.y + wrapped(dj, w.y), start_b.z + wrapped(dk, w.z));
+        const int di = e.x + lags[o][0], dj = e.y + lags[o][1], dk = e.z + lags[o][2];
+        const float f = wa * plus_x[di] * plus_y[dj] * plus_z[dk];
+        ps[o] += f * b_at(b_x[di], b_y[dj], b_z[dk]);
         qas[o] += f;
       }
     }
     for (const auto& e : s.window_b) {
       const float wb = wx_[e.x] * wy_[e.y] * wz_[e.z] * e.value;
       for (int o = 0; o < count; ++o)
-        qbs[o] += static_cast<double>(wb) * at(wx_, e.x - abs_lag[o][0]) * at(wy_, e.y - abs_lag[o][1]) *
-                  at(wz_, e.z - abs_lag[o][2]);
+        qbs[o] += static_cast<double>(wb) * minus_x[e.x - lags[o][0]] * minus_y[e.y - lags[o][1]] *
+                  minus_z[e.z - lags[o][2]];
     }
     for (int o = 0; o < count; ++o)
       out[o] = ps[o] - mean_b * qas[o] - mean_a * qbs[o] +
-               mean_a * mean_b * k_at(abs_lag[o][0], abs_lag[o][1], abs_lag[o][2]);
+               mean_a * mean_b * k_at(centre.x + lags[o][0], centre.y + lags[o][1], centre.z + lags[o][2]);
   };
   result = direct_peak<R>(r, energy_a, energy_b, outer, fallback);
   result.dx += static_cast<float>(centre.x);
