@@ -21,6 +21,7 @@
 #include "glib_handles.h"
 #include "tomorig/acquisition/frame_id.h"
 #include "tomorig/acquisition/trigger_matcher.h"
+#include "tomorig/acquisition/trigger_phase.h"
 #include "tomorig/core/error.h"
 
 namespace tomorig::acquisition {
@@ -268,17 +269,17 @@ std::optional<std::int64_t> AravisCamera::Impl::median_answer_latency() const {
   return sorted[sorted.size() / 2];
 }
 
-// Once per run (see AravisCameraOptions::readout_ns): a two-trigger camera that answers sooner
-// than half its readout gets its triggers just past its grid line instead of before it. A camera without a grid answers at the same latency either way; it only
-// triggers that much later, once.
+// Once per run (see AravisCameraOptions::readout_ns and trigger_phase.h): a two-trigger camera
+// whose quickest answer came sooner than half its readout gets its triggers just past its grid
+// line instead of before it. A camera without a grid answers at the same latency either way; it
+// only triggers that much later, once.
 void AravisCamera::Impl::judge_trigger_phase() {
   if (phase_judged || options.frame_mode != config::FrameMode::two_triggers || options.readout_ns <= 0 ||
       answer_latencies.size() < kLatenciesForPhase)
     return;
   phase_judged = true;
-  const std::int64_t latency = *median_answer_latency();
-  if (latency >= options.readout_ns / 2) return;
-  phase_delay_ns = latency + options.readout_ns / 8;
+  phase_delay_ns = trigger_phase_delay_ns(answer_latencies, options.readout_ns);
+  if (phase_delay_ns == 0) return;
   // A new regime: the nudge learns the latency again, and the matcher the camera's offset (on
   // a grid camera it grows by most of a readout; a stale offset would let a frame that crossed
   // a grid line pass for the next trigger's).

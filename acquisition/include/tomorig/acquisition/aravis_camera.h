@@ -54,9 +54,9 @@ struct AravisCameraOptions {
   // readout_us; 0: unknown). A camera that takes a trigger only at the end of its readout (a
   // frame grid, like Aravis's GigE fake) answers it at the next grid line: a trigger sent just
   // before one moves a whole readout later with the smallest host delay, and its pair is lost.
-  // Once the camera's answer latency is learned and is under half the readout, the
-  // camera's triggers are sent that latency plus an eighth of the readout later, just after
-  // the grid line: a delay then has most of a readout to spare.
+  // Once the camera has answered 8 triggers and the quickest answer came within half the
+  // readout, the camera's triggers are sent that latency plus an eighth of the readout later,
+  // just after the grid line: a delay then has most of a readout to spare (trigger_phase.h).
   std::int64_t readout_ns = 0;
   int packet_size = 0;                      // GigE GevSCPSPacketSize in bytes; 0: camera's value
   int socket_buffer_bytes = 0;              // GigE receive socket buffer; 0: Aravis default
