@@ -74,14 +74,20 @@ PassGeometry geometry_of(const CorrelationPass& pass, const VolumeView& level) {
   return g;
 }
 
-// Above this mean fraction of occupied voxels in the deformed pair, the direct correlation's
-// gathers cost more than the FFTs of a window (estimated from the operation counts: 3 x 27
-// products per occupied voxel against three N log N transforms, with a margin for the
-// gathers); a deterministic choice, so every process picks the same method.
-constexpr double kDirectMaxOccupancy = 0.08;
+// Above these mean fractions of occupied voxels in the pair, the direct correlation costs more
+// than the FFTs of the windows; deterministic, so every process picks the same method. Measured
+// per kind of pass on the tpiv-thesis FMART pairs (docs/correlation.md, "Speed", sixth round):
+//   a deformation pass (every window's lag sums from one shared contraction) at 8.9 % and 14.5 %
+//   occupancy took 2.1 and 2.8 s against the FFT's 6.7 and 8.0 s; its cost grows slowly with
+//   the occupancy, so up to a quarter occupied it stays well below the FFT's;
+//   a pass without deformation (each window searched on its own around the binned peak) at
+//   8.9 % took 1.25 s against the FFT's 1.13 s: the break-even is near 8 %.
+constexpr double kDirectMaxOccupancyDeformation = 0.25;
+constexpr double kDirectMaxOccupancyPreSearch = 0.08;
 
-bool use_direct(const CorrelationPass& pass, double occupancy) {
-  return pass.method == CorrelationMethod::direct || occupancy <= kDirectMaxOccupancy;
+bool use_direct(const CorrelationPass& pass, bool deform, double occupancy) {
+  return pass.method == CorrelationMethod::direct ||
+         occupancy <= (deform ? kDirectMaxOccupancyDeformation : kDirectMaxOccupancyPreSearch);
 }
 
 // Whether a pass can correlate directly at all: a deformation pass needs windows of 8 voxels
@@ -177,9 +183,9 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
       }
       // Where the samples have signal: made once per level, reused by every deformation pass.
       if (!level.supported) {
-        detail::signal_support(level.view_a, detail::kOccupiedThreshold, detail::kSupportRadius, threads,
+        detail::signal_support(level.view_a, detail::kSupportThreshold, detail::kSupportRadius, threads,
                                level.support_a, level.support_scratch);
-        detail::signal_support(level.view_b, detail::kOccupiedThreshold, detail::kSupportRadius, threads,
+        detail::signal_support(level.view_b, detail::kSupportThreshold, detail::kSupportRadius, threads,
                                level.support_b, level.support_scratch);
         level.supported = true;
       }
@@ -214,7 +220,7 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
       detail::list_occupied(vb, g.step, detail::kOccupiedThreshold, threads, level.occupied_b, false);
       seconds_listing = seconds_since(start_listing);
       pr.occupied_fraction = 0.5 * (occupied_a.occupied_fraction + occupied_b.occupied_fraction);
-      direct = use_direct(pass, pr.occupied_fraction);
+      direct = use_direct(pass, deform, pr.occupied_fraction);
     }
     std::optional<detail::DirectCorrelator> direct_correlator;
     double seconds_lag_sums = 0;

@@ -25,14 +25,18 @@ void bspline_prefilter(std::vector<float>& values, int nx, int ny, int nz, int t
 void signal_support(const VolumeView& v, float relative_threshold, int radius, int threads, std::vector<std::uint8_t>& out,
                     std::vector<std::uint8_t>& scratch);
 
-// The radius of signal_support that deform_pair needs: beyond it the cubic B-spline's
-// interpolant of a sampled particle image (smooth, its outer samples themselves near the
-// threshold) is below the threshold's order, so the sample is 0 without evaluating its 64 taps.
-// Measured on the benchmark pair (512 x 512 x 160, 0.05 ppp, Taylor-Green predictor): radius 2
-// evaluates 18 % of the voxels instead of 32 % at radius 3, and changes 9 of the 2.1 million
-// occupied voxels of the deformed pair and the direct pass's displacements by at most
-// 2e-4 voxel (rms 1.4e-6); radius 1 would drop 1.2 % of the occupied voxels.
-inline constexpr int kSupportRadius = 2;
+// Where deform_pair evaluates samples: within kSupportRadius voxels of a source voxel above
+// kSupportThreshold of the volume's largest magnitude. A sample's value is, to within the cubic
+// interpolant's small outer lobes, a blend of the two source voxels bracketing it on each axis,
+// and both lie within one voxel of its nearest voxel; beyond that the sample is a lobe of a
+// faint blob edge, below the threshold at which the direct correlation lists a voxel
+// (kOccupiedThreshold), so it is 0 without evaluating its 64 taps. The support threshold is a
+// third of the listing threshold: the margin for the interpolant's overshoot.
+// Measured on the tpiv-thesis FMART pair at 0.05 ppp (docs/correlation.md, "Speed", sixth
+// round): radius 1 instead of 2 halves the deformation's samples and leaves every accuracy figure
+// of `bench piv3d` (truth and FMART, 0.05 and 0.10 ppp) unchanged to the printed digits.
+inline constexpr float kSupportThreshold = 1e-3f;
+inline constexpr int kSupportRadius = 1;
 
 // Eq. 2.17 on a volume binned by `factor`: out_a(x) = a(x - d(x)/2), out_b(x) = b(x + d(x)/2),
 // with d the predictor (voxels of the full grid, node centres in full-grid voxel coordinates)
