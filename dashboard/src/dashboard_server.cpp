@@ -1,7 +1,9 @@
 #include "tomorig/dashboard/dashboard_server.h"
 
 #include <atomic>
+#include <condition_variable>
 #include <fstream>
+#include <mutex>
 #include <random>
 #include <regex>
 #include <thread>
@@ -24,6 +26,8 @@ using namespace std::chrono_literals;
 // How long an event stream waits for news before it sends a comment line, which both keeps
 // proxies from closing it and lets the server notice a browser that has gone.
 constexpr auto kKeepAlive = 2000ms;
+// How long stop() waits for the open event streams to send their end.
+constexpr auto kStreamsEndTimeout = 2000ms;
 
 const std::regex kGetPaths("/|/index\\.html|/dashboard\\.js|/dashboard\\.css|/events|/api/state|/api/history|/image/.+");
 const std::regex kPostPaths("/api/ack|/api/snapshot");
@@ -98,6 +102,8 @@ struct DashboardServer::Impl {
   std::thread thread;
   int port = 0;
   std::atomic<int> streams{0};
+  std::mutex streams_mutex;                // with streams_ended: stop() waits for the open streams
+  std::condition_variable streams_ended;
   std::atomic<bool> stopped{false};
   std::atomic<bool> listen_ended{false};
 
@@ -191,7 +197,7 @@ struct DashboardServer::Impl {
   // only (a slow browser skips, it never queues), and a comment line when nothing changes.
   void events(httplib::Response& res) {
     if (++streams > options.max_streams) {
-      --streams;
+      stream_closed();
       return reply_error(res, 503, fmt::format("{} pages are watching already; close one", options.max_streams));
     }
     auto cursor = std::make_shared<EventCursor>();
@@ -214,7 +220,22 @@ struct DashboardServer::Impl {
           for (const DashboardEvent& e : events) out += fmt::format("event: {}\ndata: {}\n\n", e.name, e.data);
           return sink.write(out.data(), out.size());
         },
-        [this](bool) { --streams; });
+        [this](bool) { stream_closed(); });
+  }
+
+  void stream_closed() {
+    {
+      std::lock_guard lock(streams_mutex);
+      --streams;
+    }
+    streams_ended.notify_all();
+  }
+
+  // Until every open event stream has ended, at most `timeout` (a page whose socket no longer
+  // takes data is left to the server's write timeout).
+  void wait_for_streams(std::chrono::milliseconds timeout) {
+    std::unique_lock lock(streams_mutex);
+    streams_ended.wait_for(lock, timeout, [this] { return streams.load() <= 0; });
   }
 };
 
@@ -300,6 +321,10 @@ std::string DashboardServer::url() const {
 void DashboardServer::stop() {
   if (impl_->stopped.exchange(true)) return;
   impl_->state.close();  // event streams waiting for news return now
+  // Every open page is told "event: end" before the server stops: once it has stopped, the
+  // server no longer calls a stream's provider, so a stream caught between two calls (its last
+  // event just written) would be cut without it, and the page would keep reconnecting.
+  impl_->wait_for_streams(kStreamsEndTimeout);
   impl_->server.stop();
   if (impl_->thread.joinable()) impl_->thread.join();
 }
