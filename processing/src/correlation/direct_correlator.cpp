@@ -45,8 +45,7 @@ void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, in
   counts.assign(block_count + 1, 0);
   // A voxel's block is its row's block offset plus its x's block column (a table: a division
   // per voxel otherwise).
-  std::vector<std::uint32_t>& block_x = o.block_column;
-  block_x.resize(static_cast<std::size_t>(v.nx));
+  std::vector<std::uint32_t> block_x(static_cast<std::size_t>(v.nx));
   for (int x = 0; x < v.nx; ++x) block_x[x] = static_cast<std::uint32_t>(x / block.x);
   auto row_block = [&](int y, int z) {
     return static_cast<std::size_t>(o.blocks.x) * (y / block.y + static_cast<std::size_t>(o.blocks.y) * (z / block.z));

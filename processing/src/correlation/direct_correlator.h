@@ -43,7 +43,6 @@ struct OccupiedVoxels {
   std::vector<std::size_t> face_offsets[6];
   std::vector<Entry> face_entries[6];
   double occupied_fraction = 0;       // entries / voxels
-  std::vector<std::uint32_t> block_column;  // list_occupied's scratch: x -> its block's x index
 };
 // Fills `out`, reusing its memory (one list per volume for a whole correlation); the face lists
 // only with `faces` (the wrapped lags read them from volume a's lists alone).
