@@ -30,6 +30,7 @@ struct Level {
   std::vector<float> a, b;              // binned samples (unused for factor 1: the inputs are used)
   VolumeView view_a, view_b;            // data null: not made yet in this correlation
   bool prefiltered = false, supported = false;
+  float largest_a = -1, largest_b = -1;  // largest magnitudes of the samples; negative: not found yet
   std::vector<float> coef_a, coef_b;    // cubic B-spline coefficients, valid if prefiltered
   std::vector<float> deformed_a, deformed_b;
   std::vector<std::uint8_t> support_a, support_b;  // signal_support of a and b, valid if supported
@@ -49,6 +50,7 @@ std::map<int, Level>& thread_levels() {
   for (auto& [factor, level] : levels) {
     level.view_a = level.view_b = {};
     level.prefiltered = level.supported = false;
+    level.largest_a = level.largest_b = -1;
   }
   return levels;
 }
@@ -169,6 +171,15 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
     const bool deform = pass.deformation && have_predictor;
 
     VolumeView va = level.view_a, vb = level.view_b;
+    // The largest magnitudes of the level's samples, found once per level when first needed
+    // (the support masks, the listing of a pass without deformation).
+    auto find_largest = [&] {
+      if (level.largest_a >= 0) return;
+      level.largest_a = detail::largest_magnitude(level.view_a, threads);
+      level.largest_b = detail::largest_magnitude(level.view_b, threads);
+    };
+    // Of va and vb: the samples', or the deformed volumes' as the deformation wrote them.
+    float largest_a = -1, largest_b = -1;
     if (deform) {
       if (pass.interpolation == Interpolation::cubic_bspline) {
         if (!level.prefiltered) {
@@ -183,14 +194,18 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
       }
       // Where the samples have signal: made once per level, reused by every deformation pass.
       if (!level.supported) {
-        detail::signal_support(level.view_a, detail::kSupportThreshold, detail::kSupportRadius, threads,
-                               level.support_a, level.support_scratch);
-        detail::signal_support(level.view_b, detail::kSupportThreshold, detail::kSupportRadius, threads,
-                               level.support_b, level.support_scratch);
+        find_largest();
+        detail::signal_support(level.view_a, detail::kSupportThreshold, level.largest_a, detail::kSupportRadius,
+                               threads, level.support_a, level.support_scratch);
+        detail::signal_support(level.view_b, detail::kSupportThreshold, level.largest_b, detail::kSupportRadius,
+                               threads, level.support_b, level.support_scratch);
         level.supported = true;
       }
-      detail::deform_pair(va, vb, predictor, g.factor, pass.interpolation, level.deformed_a, level.deformed_b, threads,
-                          level.support_a, level.support_b);
+      const detail::DeformedLargest largest = detail::deform_pair(
+          va, vb, predictor, g.factor, pass.interpolation, level.deformed_a, level.deformed_b, threads, level.support_a,
+          level.support_b);
+      largest_a = largest.a;
+      largest_b = largest.b;
       va.data = level.deformed_a.data();
       vb.data = level.deformed_b.data();
     }
@@ -216,8 +231,13 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
     double seconds_listing = 0;
     if (listable && direct_possible(pass, g, deform)) {
       const auto start_listing = std::chrono::steady_clock::now();
-      detail::list_occupied(va, g.step, detail::kOccupiedThreshold, threads, level.occupied_a, deform);
-      detail::list_occupied(vb, g.step, detail::kOccupiedThreshold, threads, level.occupied_b, false);
+      if (!deform) {
+        find_largest();
+        largest_a = level.largest_a;
+        largest_b = level.largest_b;
+      }
+      detail::list_occupied(va, g.step, detail::kOccupiedThreshold, largest_a, threads, level.occupied_a, deform);
+      detail::list_occupied(vb, g.step, detail::kOccupiedThreshold, largest_b, threads, level.occupied_b, false);
       seconds_listing = seconds_since(start_listing);
       pr.occupied_fraction = 0.5 * (occupied_a.occupied_fraction + occupied_b.occupied_fraction);
       direct = use_direct(pass, deform, pr.occupied_fraction);

@@ -31,15 +31,12 @@ void weight_autocorrelation(const std::vector<float>& w, double out[5]) {
 
 }  // namespace
 
-void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, int threads, OccupiedVoxels& o,
-                   bool faces) {
+void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, float largest, int threads,
+                   OccupiedVoxels& o, bool faces) {
   o.block = block;
   o.blocks = {ceil_div(v.nx, block.x), ceil_div(v.ny, block.y), ceil_div(v.nz, block.z)};
   const std::size_t block_count = static_cast<std::size_t>(o.blocks.x) * o.blocks.y * o.blocks.z;
   const std::size_t voxels = v.count();
-  float largest = 0.0f;
-#pragma omp parallel for num_threads(threads) reduction(max : largest) schedule(static)
-  for (long long n = 0; n < static_cast<long long>(voxels); ++n) largest = std::max(largest, std::abs(v.data[n]));
   const float threshold = relative_threshold * largest;
   std::vector<std::size_t>& counts = o.offsets;  // counts, then their running sum, then fill cursors
   counts.assign(block_count + 1, 0);
@@ -68,40 +65,50 @@ void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, in
         if (std::abs(row[x]) > threshold) f(x);
     }
   };
-  // Each block-slab of z is one iteration, so every block is counted and filled by one thread,
-  // in scan order: the lists do not depend on the thread count.
+  // One sweep over the volume: each block-slab of z is one iteration, whose rows are scanned
+  // in order into the slab's own list (which is then its part of the row lists) while its
+  // blocks are counted. The block lists are then filled from the slab lists, not from the
+  // volume: the volume is read once, not twice (it is hundreds of megabytes; the lists are a
+  // few per cent of it). Every block is counted and filled by one thread, in scan order: the
+  // lists do not depend on the thread count.
   const std::size_t row_count = static_cast<std::size_t>(v.ny) * v.nz;
+  const std::size_t slab_rows = static_cast<std::size_t>(v.ny) * block.z;
   o.row_offsets.assign(row_count + 1, 0);
+  o.slab_entries.resize(o.blocks.z);
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
-  for (int bz = 0; bz < o.blocks.z; ++bz)
+  for (int bz = 0; bz < o.blocks.z; ++bz) {
+    std::vector<OccupiedVoxels::RowEntry>& slab = o.slab_entries[bz];
+    slab.clear();
     for (int z = bz * block.z; z < std::min(v.nz, (bz + 1) * block.z); ++z)
       for (int y = 0; y < v.ny; ++y) {
         const float* row = v.data + v.linear(0, y, z);
         std::size_t* row_counts = counts.data() + row_block(y, z) + 1;
-        std::size_t in_row = 0;
+        const std::size_t before = slab.size();
         for_each_above(row, [&](int x) {
           ++row_counts[block_x[x]];
-          ++in_row;
+          slab.push_back({x, row[x]});
         });
-        o.row_offsets[y + static_cast<std::size_t>(v.ny) * z + 1] = in_row;
+        o.row_offsets[y + static_cast<std::size_t>(v.ny) * z + 1] = slab.size() - before;
       }
+  }
   for (std::size_t b = 0; b < block_count; ++b) counts[b + 1] += counts[b];
   for (std::size_t r = 0; r < row_count; ++r) o.row_offsets[r + 1] += o.row_offsets[r];
   o.entries.resize(counts[block_count]);
   o.row_entries.resize(counts[block_count]);
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
-  for (int bz = 0; bz < o.blocks.z; ++bz)
+  for (int bz = 0; bz < o.blocks.z; ++bz) {
+    const std::vector<OccupiedVoxels::RowEntry>& slab = o.slab_entries[bz];
+    std::copy(slab.begin(), slab.end(), o.row_entries.begin() + o.row_offsets[slab_rows * bz]);
+    const OccupiedVoxels::RowEntry* next = slab.data();
     for (int z = bz * block.z; z < std::min(v.nz, (bz + 1) * block.z); ++z)
       for (int y = 0; y < v.ny; ++y) {
-        const float* row = v.data + v.linear(0, y, z);
+        const std::size_t r = y + static_cast<std::size_t>(v.ny) * z;
         std::size_t* cursors = counts.data() + row_block(y, z);
-        OccupiedVoxels::RowEntry* in_row = o.row_entries.data() + o.row_offsets[y + static_cast<std::size_t>(v.ny) * z];
-        for_each_above(row, [&](int x) {
-          o.entries[cursors[block_x[x]]++] = {static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y),
-                                               static_cast<std::uint16_t>(z), row[x]};
-          *in_row++ = {x, row[x]};
-        });
+        for (const OccupiedVoxels::RowEntry* end = next + (o.row_offsets[r + 1] - o.row_offsets[r]); next < end; ++next)
+          o.entries[cursors[block_x[next->x]]++] = {static_cast<std::uint16_t>(next->x), static_cast<std::uint16_t>(y),
+                                                    static_cast<std::uint16_t>(z), next->value};
       }
+  }
   // The fill advanced each block's start to the next block's: shift back by one block.
   for (std::size_t b = block_count; b > 0; --b) counts[b] = counts[b - 1];
   counts[0] = 0;

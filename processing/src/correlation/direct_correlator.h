@@ -43,11 +43,14 @@ struct OccupiedVoxels {
   std::vector<std::size_t> face_offsets[6];
   std::vector<Entry> face_entries[6];
   double occupied_fraction = 0;       // entries / voxels
+  // list_occupied's per-block-slab row lists (memory reused from one listing to the next).
+  std::vector<std::vector<RowEntry>> slab_entries;
 };
 // Fills `out`, reusing its memory (one list per volume for a whole correlation); the face lists
-// only with `faces` (the wrapped lags read them from volume a's lists alone).
-void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, int threads, OccupiedVoxels& out,
-                   bool faces);
+// only with `faces` (the wrapped lags read them from volume a's lists alone). `largest` is the
+// volume's largest magnitude (largest_magnitude(v), or known from where the volume was made).
+void list_occupied(const VolumeView& v, Int3 block, float relative_threshold, float largest, int threads,
+                   OccupiedVoxels& out, bool faces);
 
 // Calls f(i, j, k, value) for every entry of `o` inside the window of `w` voxels at `start`
 // (i, j, k in window coordinates), visiting only the blocks the window touches.

@@ -259,13 +259,10 @@ Vec3f RowPredictor::at(double x) const {
   return {static_cast<float>(r[0]), static_cast<float>(r[1]), static_cast<float>(r[2])};
 }
 
-void signal_support(const VolumeView& v, float relative_threshold, int radius, int threads, std::vector<std::uint8_t>& out,
-                    std::vector<std::uint8_t>& scratch) {
+void signal_support(const VolumeView& v, float relative_threshold, float largest, int radius, int threads,
+                    std::vector<std::uint8_t>& out, std::vector<std::uint8_t>& scratch) {
   const int t = thread_count(threads);
   const std::size_t count = v.count();
-  float largest = 0.0f;
-#pragma omp parallel for num_threads(t) reduction(max : largest) schedule(static)
-  for (long long n = 0; n < static_cast<long long>(count); ++n) largest = std::max(largest, std::abs(v.data[n]));
   const float threshold = relative_threshold * largest;
   // Every byte of both is written below before it is read.
   std::vector<std::uint8_t>& mask = scratch;
@@ -364,13 +361,13 @@ struct RowScratch {
 // per-voxel branch); only those are evaluated.
 // (Compiled also for AVX-512 and AVX2, chosen at run time: fused multiply-adds in the B-spline
 // sums and wider lanes in the row loops.)
-[[gnu::target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")]] void deform_row(
+[[gnu::target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")]] float deform_row(
     const VolumeView& v, const std::uint8_t* support, Interpolation interpolation, int j, int k,
                 float sign, const float* hx, const float* hy, const float* hz, int next_dy, int next_dz, RowScratch& s,
                 float* out) {
   const std::size_t sy = static_cast<std::size_t>(v.nx), sz = sy * static_cast<std::size_t>(v.ny);
   const int n = v.nx;
-  if (n <= 0) return;
+  if (n <= 0) return 0.0f;
   float* xs = s.x.data();
   float* ys = s.y.data();
   float* zs = s.z.data();
@@ -445,13 +442,20 @@ struct RowScratch {
       out[i] = sample_bspline(v, x, y, z);
     }
   }
+  // The row's largest magnitude (the row is in cache): the deformed volume's, for its listing,
+  // without another sweep over it.
+  float largest = 0.0f;
+#pragma omp simd reduction(max : largest)
+  for (int i = 0; i < n; ++i) largest = std::max(largest, std::abs(out[i]));
+  return largest;
 }
 
 }  // namespace
 
-void deform_pair(const VolumeView& a, const VolumeView& b, const VectorField& predictor, int factor,
-                 Interpolation interpolation, std::vector<float>& out_a, std::vector<float>& out_b, int threads,
-                 const std::vector<std::uint8_t>& support_a, const std::vector<std::uint8_t>& support_b) {
+DeformedLargest deform_pair(const VolumeView& a, const VolumeView& b, const VectorField& predictor, int factor,
+                            Interpolation interpolation, std::vector<float>& out_a, std::vector<float>& out_b,
+                            int threads, const std::vector<std::uint8_t>& support_a,
+                            const std::vector<std::uint8_t>& support_b) {
   // Every voxel is written below: size the (reused) buffers without clearing them first.
   out_a.resize(a.count());
   out_b.resize(b.count());
@@ -461,7 +465,8 @@ void deform_pair(const VolumeView& a, const VolumeView& b, const VectorField& pr
   const int nodes_x = predictor.nx;
   const std::uint8_t* mask_a = support_a.empty() ? nullptr : support_a.data();
   const std::uint8_t* mask_b = support_b.empty() ? nullptr : support_b.data();
-#pragma omp parallel num_threads(thread_count(threads))
+  float largest_a = 0.0f, largest_b = 0.0f;
+#pragma omp parallel num_threads(thread_count(threads)) reduction(max : largest_a, largest_b)
   {
   const FlushDenormals flush;
   RowPredictor along_row(predictor);  // the predictor's y-z interpolation once per row
@@ -494,12 +499,13 @@ void deform_pair(const VolumeView& a, const VolumeView& b, const VectorField& pr
       // the next slice.
       const int tile_last = std::min(a.ny, (tile + 1) * kTileRows) - 1;
       const int next_dy = j < tile_last ? 1 : tile * kTileRows - j, next_dz = j < tile_last ? 0 : 1;
-      deform_row(a, mask_a, interpolation, j, k, -1.0f, hx.data(), hy.data(), hz.data(), next_dy, next_dz, scratch,
-                 out_a.data() + row);
-      deform_row(b, mask_b, interpolation, j, k, +1.0f, hx.data(), hy.data(), hz.data(), next_dy, next_dz, scratch,
-                 out_b.data() + row);
+      largest_a = std::max(largest_a, deform_row(a, mask_a, interpolation, j, k, -1.0f, hx.data(), hy.data(), hz.data(),
+                                                 next_dy, next_dz, scratch, out_a.data() + row));
+      largest_b = std::max(largest_b, deform_row(b, mask_b, interpolation, j, k, +1.0f, hx.data(), hy.data(), hz.data(),
+                                                 next_dy, next_dz, scratch, out_b.data() + row));
     }
   }
+  return {largest_a, largest_b};
 }
 
 }  // namespace tomorig::piv::detail

@@ -20,10 +20,10 @@ void downsample_sum(const VolumeView& v, int factor, int threads, std::vector<fl
 void bspline_prefilter(std::vector<float>& values, int nx, int ny, int nz, int threads);
 
 // Where a volume has signal: 1 for voxels within `radius` voxels (Chebyshev) of a sample whose
-// magnitude exceeds `relative_threshold` times the volume's largest, else 0.
+// magnitude exceeds `relative_threshold` times `largest` (the volume's largest magnitude), else 0.
 // Into `out`, with `scratch` for the intermediate dilation (both reuse their memory).
-void signal_support(const VolumeView& v, float relative_threshold, int radius, int threads, std::vector<std::uint8_t>& out,
-                    std::vector<std::uint8_t>& scratch);
+void signal_support(const VolumeView& v, float relative_threshold, float largest, int radius, int threads,
+                    std::vector<std::uint8_t>& out, std::vector<std::uint8_t>& scratch);
 
 // Where deform_pair evaluates samples: within kSupportRadius voxels of a source voxel above
 // kSupportThreshold of the volume's largest magnitude. A sample's value is, to within the cubic
@@ -45,9 +45,14 @@ inline constexpr int kSupportRadius = 1;
 // B-spline coefficients for cubic interpolation. Outside the volume the intensity is 0.
 // `support_a` / `support_b` (signal_support of the samples, may be empty: everywhere) mark
 // where a sample can be non-zero; elsewhere the output is 0 and not interpolated.
-void deform_pair(const VolumeView& a, const VolumeView& b, const VectorField& predictor, int factor,
-                 Interpolation interpolation, std::vector<float>& out_a, std::vector<float>& out_b, int threads,
-                 const std::vector<std::uint8_t>& support_a = {}, const std::vector<std::uint8_t>& support_b = {});
+// Returns the largest magnitude of each deformed volume (found row by row as they are written).
+struct DeformedLargest {
+  float a = 0.0f, b = 0.0f;
+};
+DeformedLargest deform_pair(const VolumeView& a, const VolumeView& b, const VectorField& predictor, int factor,
+                            Interpolation interpolation, std::vector<float>& out_a, std::vector<float>& out_b,
+                            int threads, const std::vector<std::uint8_t>& support_a = {},
+                            const std::vector<std::uint8_t>& support_b = {});
 
 // The predictor at a full-grid voxel position: trilinear between nodes, linearly extrapolated
 // from the end cell up to one node spacing beyond the outermost nodes, constant further out.

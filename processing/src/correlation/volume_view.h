@@ -14,6 +14,9 @@ struct VolumeView {
   std::size_t count() const { return static_cast<std::size_t>(nx) * ny * nz; }
 };
 
+// The largest |value| of the volume (0 for an empty one), on `threads` threads.
+float largest_magnitude(const VolumeView& v, int threads);
+
 struct Int3 {
   int x = 0, y = 0, z = 0;
 };

@@ -50,7 +50,7 @@ void expect_lists_match_a_plain_scan(int nx, int ny, int nz, Int3 block) {
   const float largest = 1.2f, threshold = relative * largest;
   const Volume v = make_volume(nx, ny, nz, threshold, 7u + nx);
   OccupiedVoxels o;
-  list_occupied(v.view(), block, relative, 2, o, true);
+  list_occupied(v.view(), block, relative, tomorig::piv::detail::largest_magnitude(v.view(), 2), 2, o, true);
 
   const Int3 blocks{(nx + block.x - 1) / block.x, (ny + block.y - 1) / block.y, (nz + block.z - 1) / block.z};
   ASSERT_EQ(o.blocks.x, blocks.x);
