@@ -183,10 +183,8 @@ VectorField correlate(const DenseVolume& a, const DenseVolume& b, const Correlat
     if (deform) {
       if (pass.interpolation == Interpolation::cubic_bspline) {
         if (!level.prefiltered) {
-          level.coef_a.assign(level.view_a.data, level.view_a.data + level.view_a.count());
-          level.coef_b.assign(level.view_b.data, level.view_b.data + level.view_b.count());
-          detail::bspline_prefilter(level.coef_a, va.nx, va.ny, va.nz, threads);
-          detail::bspline_prefilter(level.coef_b, vb.nx, vb.ny, vb.nz, threads);
+          detail::bspline_coefficients(level.view_a, threads, level.coef_a);
+          detail::bspline_coefficients(level.view_b, threads, level.coef_b);
           level.prefiltered = true;
         }
         va.data = level.coef_a.data();

@@ -163,34 +163,42 @@ void downsample_sum(const VolumeView& v, int factor, int threads, std::vector<fl
     }
 }
 
-void bspline_prefilter(std::vector<float>& values, int nx, int ny, int nz, int threads) {
+void bspline_coefficients(const VolumeView& samples, int threads, std::vector<float>& out) {
   const int t = thread_count(threads);
+  const int nx = samples.nx, ny = samples.ny, nz = samples.nz;
+  out.resize(samples.count());  // every element is written below
   const std::size_t sy = nx, sz = static_cast<std::size_t>(nx) * ny;
 #pragma omp parallel num_threads(t)
   {
     const FlushDenormals flush;
+    // x and y slice by slice, while the slice is in cache: the samples are read straight into
+    // the x lines (no separate copy), and the y recursion runs on the slice just written. Two
+    // sweeps over the volume in all (this one and z) instead of four (copy, x, y, z): the
+    // prefilter is bound by memory traffic.
     // x: kLines lines at a time, transposed into a small buffer (element k of every line one
     // contiguous row) so that the recursion runs over the lines in float lanes as in y and z;
     // one line at a time it is a chain of dependent scalar operations.
     constexpr int kLines = 8;
     std::vector<float> lines(static_cast<std::size_t>(nx) * kLines);
 #pragma omp for schedule(static)
-    for (int k = 0; k < nz; ++k)
+    for (int k = 0; k < nz; ++k) {
+      const float* source = samples.data + k * sz;
+      float* slice = out.data() + k * sz;
       for (int j0 = 0; j0 < ny; j0 += kLines) {
         const int width = std::min(kLines, ny - j0);
-        float* slice = values.data() + k * sz + j0 * sy;
         for (int l = 0; l < width; ++l)
-          for (int i = 0; i < nx; ++i) lines[static_cast<std::size_t>(i) * kLines + l] = slice[l * sy + i];
+          for (int i = 0; i < nx; ++i) lines[static_cast<std::size_t>(i) * kLines + l] = source[(j0 + l) * sy + i];
         prefilter_rows(lines.data(), kLines, nx, width);
         for (int l = 0; l < width; ++l)
-          for (int i = 0; i < nx; ++i) slice[l * sy + i] = lines[static_cast<std::size_t>(i) * kLines + l];
+          for (int i = 0; i < nx; ++i) slice[(j0 + l) * sy + i] = lines[static_cast<std::size_t>(i) * kLines + l];
       }
-    // y and z: all lines of a slice (or of an x-z sheet) advance together, row by row, so the
-    // inner loop runs over contiguous x (vectorised, no strided gathers).
+      // y: all lines of the slice advance together, row by row, so the inner loop runs over
+      // contiguous x (vectorised, no strided gathers).
+      prefilter_rows(slice, sy, ny, nx);
+    }
+    // z: likewise over the rows of each x-z sheet.
 #pragma omp for schedule(static)
-    for (int k = 0; k < nz; ++k) prefilter_rows(values.data() + k * sz, sy, ny, nx);
-#pragma omp for schedule(static)
-    for (int j = 0; j < ny; ++j) prefilter_rows(values.data() + j * sy, sz, nz, nx);
+    for (int j = 0; j < ny; ++j) prefilter_rows(out.data() + j * sy, sz, nz, nx);
   }
 }
 

@@ -15,9 +15,9 @@ namespace tomorig::piv::detail {
 // Into `out`, reusing its memory.
 void downsample_sum(const VolumeView& v, int factor, int threads, std::vector<float>& out);
 
-// In-place interpolating cubic B-spline coefficients (Unser's recursive filter, mirror
-// boundaries), so that the spline passes through the samples.
-void bspline_prefilter(std::vector<float>& values, int nx, int ny, int nz, int threads);
+// The interpolating cubic B-spline coefficients of `samples` (Unser's recursive filter, mirror
+// boundaries), so that the spline passes through the samples. Into `out`, reusing its memory.
+void bspline_coefficients(const VolumeView& samples, int threads, std::vector<float>& out);
 
 // Where a volume has signal: 1 for voxels within `radius` voxels (Chebyshev) of a sample whose
 // magnitude exceeds `relative_threshold` times `largest` (the volume's largest magnitude), else 0.
