@@ -173,8 +173,8 @@ void bspline_coefficients(const VolumeView& samples, int threads, std::vector<fl
     const FlushDenormals flush;
     // x and y slice by slice, while the slice is in cache: the samples are read straight into
     // the x lines (no separate copy), and the y recursion runs on the slice just written. Two
-    // sweeps over the volume in all (this one and z) instead of four (copy, x, y, z): the
-    // prefilter is bound by memory traffic.
+    // sweeps over the volume in all (this one and z) instead of four (copy, x, y, z); measured
+    // on the tpiv-thesis FMART pair, both volumes' coefficients took 0.12 s instead of 0.13.
     // x: kLines lines at a time, transposed into a small buffer (element k of every line one
     // contiguous row) so that the recursion runs over the lines in float lanes as in y and z;
     // one line at a time it is a chain of dependent scalar operations.
