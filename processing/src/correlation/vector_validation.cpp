@@ -90,11 +90,15 @@ ValidationCounts validate_field(VectorField& field, const CorrelationOptions& op
           for (int c = 0; c < 3; ++c) {
             float* values = hood.components[c].data();
             const float median = median_of(values, hood.count);
+            // The residuals' median only raises the denominator above epsilon: a component
+            // within threshold * epsilon of the median passes whatever it is (the same
+            // decision, most components of a good field, without the second median).
+            const double deviation = std::fabs(component(field.displacement[n], c) - median);
+            if (deviation / options.median_test.epsilon <= options.median_test.threshold) continue;
             std::array<float, 26> residuals{};
             for (int m = 0; m < hood.count; ++m) residuals[m] = std::fabs(values[m] - median);
             const float residual_median = median_of(residuals.data(), hood.count);
-            const double normalised = std::fabs(component(field.displacement[n], c) - median) /
-                                      (residual_median + options.median_test.epsilon);
+            const double normalised = deviation / (residual_median + options.median_test.epsilon);
             if (normalised > options.median_test.threshold) {
               fails[n] = 1;
               break;
