@@ -409,10 +409,11 @@ struct RowScratch {
       // side by side, docs/correlation.md "Speed", seventh round).
       const long long last = static_cast<long long>(v.count()) - 1;
       const long long next = static_cast<long long>(next_dy) * row_y + static_cast<long long>(next_dz) * slice;
-      for (int i = 0; i < n; i += 64) __builtin_prefetch(support + std::min(last, nearest[i] + next));
+      // (Clamped into the volume: the pointers stay inside their arrays.)
+      for (int i = 0; i < n; i += 64) __builtin_prefetch(support + std::clamp(nearest[i] + next, 0LL, last));
       if (interpolation == Interpolation::cubic_bspline) {
         const long long far = next + 2LL * row_y + 2LL * slice;
-        for (int i = 0; i < n; i += 16) __builtin_prefetch(v.data + std::min(last, nearest[i] + far));
+        for (int i = 0; i < n; i += 16) __builtin_prefetch(v.data + std::clamp(nearest[i] + far, 0LL, last));
       }
       for (int i = 0; i < n; ++i) {
         kept[count] = i;
