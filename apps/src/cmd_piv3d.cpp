@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
 
 #include "commands.h"
 #include "json_summary.h"
@@ -25,7 +26,8 @@ struct Piv3dArgs {
 };
 
 void run(const Piv3dArgs& args) {
-  const pipeline::VolumePairReport report = pipeline::correlate_volume_pair(args.options);
+  const pipeline::VolumePairReport report =
+      pipeline::correlate_volume_pair(args.options, [](const std::string& message) { spdlog::info("{}", message); });
   const piv::CorrelationReport& c = report.correlation;
   nlohmann::json summary = json_summary("piv3d");
   summary.update(nlohmann::json{{"out", report.out},

@@ -25,7 +25,8 @@ std::int64_t recorded_dt_ns(const storage::VolumeFileReader& file) {
 
 }  // namespace
 
-VolumePairReport correlate_volume_pair(const VolumePairOptions& args) {
+VolumePairReport correlate_volume_pair(const VolumePairOptions& args,
+                                       const std::function<void(const std::string& message)>& progress) {
   // Before anything is read: an existing results file (perhaps a whole `process` run) is never
   // replaced without --overwrite.
   storage::check_output_path(args.out, args.overwrite, "results");
@@ -68,7 +69,8 @@ VolumePairReport correlate_volume_pair(const VolumePairOptions& args) {
   const SparseVolume b = file_b.read_sparse(name_b);
   VolumePairReport report;
   report.name_b = name_b;
-  fmt::print(stderr, "correlating '{}' and '{}' ({} x {} x {} voxels)...\n", args.name_a, name_b, ga.nx, ga.ny, ga.nz);
+  if (progress)
+    progress(fmt::format("correlating '{}' and '{}' ({} x {} x {} voxels)...", args.name_a, name_b, ga.nx, ga.ny, ga.nz));
   storage::SetResult result;
   result.field = piv::correlate(a, b, options, report.correlation);
   result.set_index = file_a.info().set_index;

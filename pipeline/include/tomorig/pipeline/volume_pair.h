@@ -1,6 +1,7 @@
 #pragma once
 // `tomorig piv3d`: correlate two given volumes (e.g. the two exposures `tomorig reconstruct`
 // wrote, /volumes/a and /volumes/b) into a results file with one set.
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -31,7 +32,9 @@ struct VolumePairReport {
 
 // Checks the output path (never replaced without `overwrite`), the two volumes' grids and the
 // pulse separation before any voxel is read, correlates, and writes the results file.
-// Throws tomorig::Error (bad_input) naming what is wrong and the fix.
-VolumePairReport correlate_volume_pair(const VolumePairOptions& options);
+// `progress` is told (one line of text) when the correlation starts. Throws tomorig::Error
+// (bad_input) naming what is wrong and the fix.
+VolumePairReport correlate_volume_pair(const VolumePairOptions& options,
+                                       const std::function<void(const std::string& message)>& progress = {});
 
 }  // namespace tomorig::pipeline
