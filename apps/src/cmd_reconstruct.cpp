@@ -1,7 +1,6 @@
-// tomorig reconstruct: one set of a session -> a volume file (HDF5 + XDMF) per exposure; with
-// --mean the mean intensity volume over --sets (spray statistics, pipeline/mean_volume.h).
-#include <chrono>
-#include <filesystem>
+// tomorig reconstruct: one set of a session -> a volume file (HDF5 + XDMF) per exposure
+// (pipeline/set_volumes.h); with --mean the mean intensity volume over --sets (spray statistics,
+// pipeline/mean_volume.h). This file parses the options and prints the report.
 #include <memory>
 #include <string>
 #include <vector>
@@ -9,31 +8,19 @@
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
 
 #include "commands.h"
-#include "tomorig/pipeline/report_json.h"
 #include "json_summary.h"
 #include "tomorig/core/cli_vocabulary.h"
-#include "tomorig/pipeline/exposure_images.h"
+#include "tomorig/core/error.h"
 #include "tomorig/pipeline/mean_volume.h"
 #include "tomorig/pipeline/session_geometry.h"
-#include "tomorig/pipeline/session_preprocessor.h"
-#include "tomorig/config/rig_config.h"
-#include "tomorig/core/error.h"
-#include "tomorig/processing/quality/depth_profile_plot.h"
-#include "tomorig/processing/reconstruction/reconstructor.h"
-#include "tomorig/processing/reconstruction/smoothing.h"
-#include "tomorig/storage/image_file.h"
-#include "tomorig/storage/output_path.h"
-#include "tomorig/storage/session_file.h"
+#include "tomorig/pipeline/set_volumes.h"
 #include "tomorig/storage/volume_file.h"
 
 namespace tomorig::app {
 
-using pipeline::ReconstructionSetup;
-using pipeline::SessionCameras;
-using pipeline::reconstruction_setup;
-using pipeline::session_cameras;
 using pipeline::to_json;
 
 namespace {
@@ -107,72 +94,31 @@ void run(const ReconstructArgs& args) {
   if (args.mean) return run_mean(args);
   if (!args.sets.empty() || !args.slices.empty())
     throw bad_input("--sets and --slices belong to --mean (the mean intensity volume over sets); one set is --set K");
-  if (!args.png.empty()) storage::check_output_path(args.png, args.overwrite, "plot");  // before any work
-  const storage::SessionReader session(args.session);
-  if (args.set >= session.set_count())
-    throw bad_input(fmt::format("--set {} is out of range: session '{}' has {} sets (0 to {})", args.set,
-                                args.session, session.set_count(),
-                                session.set_count() == 0 ? 0 : session.set_count() - 1));
-  const pipeline::SessionDescription description = pipeline::describe_session(session);
-  const SessionCameras cameras = session_cameras(description, args.calib);
-  for (const std::string& warning : cameras.warnings) fmt::print(stderr, "warning: {}\n", warning);
-
-  ReconstructionSetup setup = reconstruction_setup(description, cameras, args.recon);
-  const recon::ReconstructionOptions& options = setup.options;
-  const auto reconstructor = recon::make_reconstructor(options);
-  recon::ReconstructionInput& input = setup.input;
-
-  FrameSet set = session.read_set(args.set);
-  pipeline::SessionPreprocessor(session, args.chain).apply(set);
-  nlohmann::json parameters = {{"algorithm", options.algorithm},
-                               {"max_iterations", options.max_iterations},
-                               {"relaxation", options.relaxation},
-                               {"sigma_px", args.recon.sigma_px},
-                               {"psf", args.recon.psf},
-                               {"chain", args.chain},
-                               {"smoothing_sigma_voxel", args.smooth},
-                               {"cameras", cameras.source},
-                               {"dt_ns", set.dt_ns}};
-  if (!args.recon.psf.empty()) parameters["sigma_px"] = nullptr;  // each camera's sigma over depth instead
-  storage::VolumeFileWriter out(args.out, {args.session, args.set, parameters.dump()},
-                                {.overwrite = args.overwrite, .dense_export = !args.sparse_only});
-  nlohmann::json reports = nlohmann::json::object();
-  std::vector<quality::DepthCurve> depth_curves;
-  for (const Exposure e : exposures_of(args.exposure)) {
-    const std::string name = e == Exposure::A ? "a" : "b";
-    input.images = pipeline::exposure_images(set, e, args.session, args.set,
-                                             "this exposure cannot be reconstructed: choose another set");
-    fmt::print(stderr, "reconstructing set {} exposure {} with {} on a {} x {} x {} grid...\n", args.set,
-               e == Exposure::A ? "A" : "B", options.algorithm, input.grid.nx, input.grid.ny, input.grid.nz);
-    recon::ReconstructionReport report;
-    SparseVolume volume = reconstructor->reconstruct(input, report);
-    if (!args.smooth.empty()) volume = recon::gaussian_smooth(volume, {args.smooth[0], args.smooth[1], args.smooth[2]},
-                                         args.recon.options.threads);
-    fmt::print(stderr, "  {}\n", report.brief());
-    const nlohmann::json report_json = to_json(report);
-    out.add(name, volume, {options.algorithm, e == Exposure::A ? "A" : "B", report_json.dump()});
-    reports[name] = report_json;
-    if (!args.png.empty()) {
-      quality::DepthCurve curve{e == Exposure::A ? "exposure A" : "exposure B", {}, quality::mean_intensity_per_slice(volume)};
-      for (int k = 0; k < volume.grid.nz; ++k) curve.z_mm.push_back(volume.grid.centre_of(0, 0, k).z);
-      depth_curves.push_back(std::move(curve));
-    }
-  }
-  out.finish();
-  if (!args.png.empty())
-    storage::write_png(args.png, quality::depth_profile_plot(
-                                     depth_curves, fmt::format("set {}, {}", args.set, options.algorithm)));
+  pipeline::SetVolumesOptions o;
+  o.session = args.session;
+  o.calib = args.calib;
+  o.set = args.set;
+  o.exposures = exposures_of(args.exposure);
+  o.chain = args.chain;
+  o.recon = args.recon;
+  o.smooth = args.smooth;
+  o.out = args.out;
+  o.png = args.png;
+  o.sparse_only = args.sparse_only;
+  o.overwrite = args.overwrite;
+  const pipeline::SetVolumesReport r =
+      pipeline::write_set_volumes(o, {.warning = [](const std::string& text) { spdlog::warn("{}", text); },
+                                      .progress = [](const std::string& text) { spdlog::info("{}", text); }});
   nlohmann::json summary = json_summary("reconstruct");
   summary.update(nlohmann::json{{"out", args.out},
-                                {"xdmf", storage::VolumeFileWriter::sidecar_path(args.out).string()},
+                                {"xdmf", r.xdmf.string()},
                                 {"session", args.session},
                                 {"set", args.set},
-                                {"volumes", reports}});
+                                {"volumes", r.volumes}});
   emit_json(args.json, summary);
-  if (!args.json.to_stdout()) {
-    fmt::print("wrote {} and {} ({} volume{})\n", args.out, storage::VolumeFileWriter::sidecar_path(args.out).string(),
-               reports.size(), reports.size() == 1 ? "" : "s");
-  }
+  if (!args.json.to_stdout())
+    fmt::print("wrote {} and {} ({} volume{})\n", args.out, r.xdmf.string(), r.volumes.size(),
+               r.volumes.size() == 1 ? "" : "s");
 }
 
 }  // namespace
