@@ -5,7 +5,6 @@
 #include <optional>
 #include <string>
 
-#include "tomorig/core/vector_field.h"
 #include "tomorig/pipeline/correlation_args.h"
 #include "tomorig/processing/correlation/correlate.h"
 
