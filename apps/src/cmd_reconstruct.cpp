@@ -53,21 +53,28 @@ std::vector<Exposure> exposures_of(const std::string& name) {
   return {Exposure::A, Exposure::B};
 }
 
-void run_mean(const ReconstructArgs& args) {
-  if (args.set_opt->count()) throw bad_input("--mean averages the sets of --sets (default all): --set does not apply");
-  if (!args.png.empty()) throw bad_input("--png draws one set's depth profile; with --mean use --slices FOLDER");
-  pipeline::MeanVolumeOptions o;
+// The options one set's volumes and the mean volume share, from the command line.
+template <class Options>
+Options shared_options(const ReconstructArgs& args) {
+  Options o;
   o.session = args.session;
   o.calib = args.calib;
   o.chain = args.chain;
   o.recon = args.recon;
-  o.sets = args.sets;
   o.exposures = exposures_of(args.exposure);
   o.smooth = args.smooth;
   o.out = args.out;
-  o.slices = args.slices;
   o.sparse_only = args.sparse_only;
   o.overwrite = args.overwrite;
+  return o;
+}
+
+void run_mean(const ReconstructArgs& args) {
+  if (args.set_opt->count()) throw bad_input("--mean averages the sets of --sets (default all): --set does not apply");
+  if (!args.png.empty()) throw bad_input("--png draws one set's depth profile; with --mean use --slices FOLDER");
+  auto o = shared_options<pipeline::MeanVolumeOptions>(args);
+  o.sets = args.sets;
+  o.slices = args.slices;
   const pipeline::MeanVolumeReport r = pipeline::write_mean_volume(o, [](int done, int total) {
     fmt::print(stderr, "mean: volume {}/{} reconstructed\n", done, total);
   });
@@ -94,18 +101,9 @@ void run(const ReconstructArgs& args) {
   if (args.mean) return run_mean(args);
   if (!args.sets.empty() || !args.slices.empty())
     throw bad_input("--sets and --slices belong to --mean (the mean intensity volume over sets); one set is --set K");
-  pipeline::SetVolumesOptions o;
-  o.session = args.session;
-  o.calib = args.calib;
+  auto o = shared_options<pipeline::SetVolumesOptions>(args);
   o.set = args.set;
-  o.exposures = exposures_of(args.exposure);
-  o.chain = args.chain;
-  o.recon = args.recon;
-  o.smooth = args.smooth;
-  o.out = args.out;
   o.png = args.png;
-  o.sparse_only = args.sparse_only;
-  o.overwrite = args.overwrite;
   const pipeline::SetVolumesReport r =
       pipeline::write_set_volumes(o, {.warning = [](const std::string& text) { spdlog::warn("{}", text); },
                                       .progress = [](const std::string& text) { spdlog::info("{}", text); }});
