@@ -75,9 +75,9 @@ SessionPreprocessor::SessionPreprocessor(const storage::SessionReader& session, 
       for (const Exposure e : {Exposure::A, Exposure::B}) {
         const int k = static_cast<int>(e);
         if ((minimum ? minima[c][k].count() : means[c][k].count()) == 0)
-          throw bad_input(fmt::format("camera '{}' has no frame {} in sets {} to {}, so preprocess step {} ({}) has "
-                                      "no sequence image; select more sets",
-                                      session.info().cameras[c].id, k == 0 ? "A" : "B", first, end - 1, step,
+          throw bad_input(fmt::format("camera '{}' has no frame {} in the {} sets from set {}, so preprocess step {} "
+                                      "({}) has no sequence image; select more sets",
+                                      session.info().cameras[c].id, k == 0 ? "A" : "B", end - first, first, step,
                                       to_string(spec.steps[step].kind)));
         chains_[c].set_sequence_image(step, e, minimum ? minima[c][k].result() : means[c][k].result());
       }
