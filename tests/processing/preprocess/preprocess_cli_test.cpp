@@ -113,6 +113,36 @@ TEST_F(PreprocessCli, ClipAboveEveryValueLeavesZeroFrames) {
   EXPECT_EQ(accepted.exit_code, 0) << accepted.err;
 }
 
+// The sequence statistics come from the selected sets only: the minimum over one set is that
+// set's own frame, so subtracting it leaves zero frames (a flat field then refuses them as
+// dark); over both sets of the session it would not (particles move between sets).
+TEST_F(PreprocessCli, SequenceStatisticsComeFromTheSelectedSetsOnly) {
+  const auto minimum = dir_ / "minimum.toml";
+  write_text(minimum, "[[preprocess.steps]]\nkind = \"subtract_minimum\"\n");
+  auto flat_of = [&](const std::filesystem::path& session, const std::string& name) {
+    const auto chain = dir_ / (name + ".toml");
+    write_text(chain, "[[preprocess.steps]]\nkind = \"flat_field\"\nfile = \"" + session.string() + "\"\n");
+    return run_tomorig("preprocess --session " + shell_quoted(session_.string()) + " --chain " +
+                       shell_quoted(chain.string()) + " -o " + shell_quoted((dir_ / (name + ".h5")).string()));
+  };
+  const auto one = dir_ / "min_one.h5";
+  ASSERT_EQ(run_tomorig("preprocess --session " + shell_quoted(session_.string()) + " --chain " +
+                        shell_quoted(minimum.string()) + " --sets 1:2 -o " + shell_quoted(one.string()))
+                .exit_code,
+            0);
+  const CliResult dark = flat_of(one, "flat_one");
+  EXPECT_EQ(dark.exit_code, 2);
+  EXPECT_NE(dark.err.find("is dark (mean 0)"), std::string::npos) << dark.err;
+
+  const auto both = dir_ / "min_both.h5";
+  ASSERT_EQ(run_tomorig("preprocess --session " + shell_quoted(session_.string()) + " --chain " +
+                        shell_quoted(minimum.string()) + " -o " + shell_quoted(both.string()))
+                .exit_code,
+            0);
+  const CliResult lit = flat_of(both, "flat_both");
+  EXPECT_EQ(lit.exit_code, 0) << lit.err;
+}
+
 TEST_F(PreprocessCli, BadChainFileIsExitTwoNamingTheKey) {
   const auto chain = dir_ / "bad.toml";
   write_text(chain, "[[preprocess.steps]]\nkind = \"median\"\nsize = 4\n");
