@@ -2,7 +2,6 @@
 
 #include "tomorig/core/set_selection.h"
 #include "tomorig/pipeline/session_preprocessor.h"
-#include "tomorig/processing/preprocess/chain_spec.h"
 #include "tomorig/storage/output_path.h"
 #include "tomorig/storage/session_file.h"
 
@@ -18,16 +17,13 @@ PreprocessedSessionReport write_preprocessed_session(const PreprocessedSessionOp
   report.first_set = first;
   report.sets = end - first;
   report.cameras = session.info().cameras.size();
-  // The passes, for the progress, before the first: one per step needing a sequence statistic,
-  // then the one that writes.
-  const preprocess::ChainSpec spec = preprocess::read_chain(options.chain.string());
-  report.steps = spec.steps.size();
-  report.passes = 1;
-  for (const preprocess::Step& step : spec.steps) report.passes += preprocess::needs_sequence_image(step);
-  const auto tell = [&](std::size_t pass, std::uint64_t done) {
-    if (progress) progress(pass, report.passes, done, report.sets);
+  // The sequence passes, then the one that writes.
+  const auto tell = [&](std::size_t pass, std::size_t sequence_passes, std::uint64_t done) {
+    if (progress) progress(pass, sequence_passes + 1, done, report.sets);
   };
   SessionPreprocessor chains(session, options.chain, selection, tell);
+  report.steps = chains.steps();
+  report.passes = chains.sequence_passes() + 1;
 
   storage::SessionInfo info = session.info();
   info.software_version.clear();
@@ -43,7 +39,7 @@ PreprocessedSessionReport write_preprocessed_session(const PreprocessedSessionOp
     chains.apply_as_uint16(set);
     writer.append(set);
     if (session.has_truth_set(s)) writer.write_truth_set(s - first, session.truth_set(s));
-    tell(report.passes - 1, s - first + 1);
+    if (progress) progress(report.passes - 1, report.passes, s - first + 1, report.sets);
   }
   writer.finish();
   return report;

@@ -1,5 +1,6 @@
 #include "tomorig/pipeline/session_preprocessor.h"
 
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <stdexcept>
@@ -52,6 +53,9 @@ SessionPreprocessor::SessionPreprocessor(const storage::SessionReader& session, 
       }
   }
   const auto [first, end] = sets.range(session.set_count());
+  sequence_passes_ = static_cast<std::size_t>(std::count_if(
+      spec.steps.begin(), spec.steps.end(), [](const preprocess::Step& s) { return preprocess::needs_sequence_image(s); }));
+  std::size_t pass = 0;
   // One streaming pass per step that needs a sequence statistic, each over the chain up to
   // that step (so a later statistic sees the earlier steps' output).
   for (std::size_t step = 0; step < spec.steps.size(); ++step) {
@@ -69,7 +73,7 @@ SessionPreprocessor::SessionPreprocessor(const storage::SessionReader& session, 
           if (minimum) minima[c][static_cast<int>(e)].add(partial);
           else means[c][static_cast<int>(e)].add(partial);
         }
-      if (progress) progress(sequence_passes_, s - first + 1);
+      if (progress) progress(pass, sequence_passes_, s - first + 1);
     }
     for (std::size_t c = 0; c < chains_.size(); ++c)
       for (const Exposure e : {Exposure::A, Exposure::B}) {
@@ -81,7 +85,7 @@ SessionPreprocessor::SessionPreprocessor(const storage::SessionReader& session, 
                                       to_string(spec.steps[step].kind)));
         chains_[c].set_sequence_image(step, e, minimum ? minima[c][k].result() : means[c][k].result());
       }
-    ++sequence_passes_;
+    ++pass;
   }
 }
 

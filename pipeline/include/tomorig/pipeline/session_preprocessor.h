@@ -25,9 +25,9 @@ Image reference_image(const std::filesystem::path& file, const std::string& came
 
 class SessionPreprocessor {
  public:
-  // After each set of a sequence pass: pass (0-based) of the chain's sequence_passes(), sets
-  // done of the selection's.
-  using PassProgress = std::function<void(std::size_t pass, std::uint64_t done)>;
+  // After each set of a sequence pass: pass (0-based) of `passes` (the chain's
+  // sequence_passes()), sets done of the selection's.
+  using PassProgress = std::function<void(std::size_t pass, std::size_t passes, std::uint64_t done)>;
 
   // An empty `chain_file`: no preprocessing. The sequence statistics come from the sets of
   // `sets` (a contiguous run; default every set). Throws tomorig::Error (bad_input) for a bad
