@@ -119,26 +119,25 @@ TEST_F(PreprocessCli, ClipAboveEveryValueLeavesZeroFrames) {
 TEST_F(PreprocessCli, SequenceStatisticsComeFromTheSelectedSetsOnly) {
   const auto minimum = dir_ / "minimum.toml";
   write_text(minimum, "[[preprocess.steps]]\nkind = \"subtract_minimum\"\n");
+  // This suite's session through `chain` (with `extra` options) into `out`.
+  auto preprocess = [&](const std::filesystem::path& chain, const std::string& extra, const std::filesystem::path& out) {
+    return run_tomorig("preprocess --session " + shell_quoted(session_.string()) + " --chain " +
+                       shell_quoted(chain.string()) + extra + " -o " + shell_quoted(out.string()));
+  };
+  // A flat-field step whose bright field is `session`.
   auto flat_of = [&](const std::filesystem::path& session, const std::string& name) {
     const auto chain = dir_ / (name + ".toml");
     write_text(chain, "[[preprocess.steps]]\nkind = \"flat_field\"\nfile = \"" + session.string() + "\"\n");
-    return run_tomorig("preprocess --session " + shell_quoted(session_.string()) + " --chain " +
-                       shell_quoted(chain.string()) + " -o " + shell_quoted((dir_ / (name + ".h5")).string()));
+    return preprocess(chain, "", dir_ / (name + ".h5"));
   };
   const auto one = dir_ / "min_one.h5";
-  ASSERT_EQ(run_tomorig("preprocess --session " + shell_quoted(session_.string()) + " --chain " +
-                        shell_quoted(minimum.string()) + " --sets 1:2 -o " + shell_quoted(one.string()))
-                .exit_code,
-            0);
+  ASSERT_EQ(preprocess(minimum, " --sets 1:2", one).exit_code, 0);
   const CliResult dark = flat_of(one, "flat_one");
   EXPECT_EQ(dark.exit_code, 2);
   EXPECT_NE(dark.err.find("is dark (mean 0)"), std::string::npos) << dark.err;
 
   const auto both = dir_ / "min_both.h5";
-  ASSERT_EQ(run_tomorig("preprocess --session " + shell_quoted(session_.string()) + " --chain " +
-                        shell_quoted(minimum.string()) + " -o " + shell_quoted(both.string()))
-                .exit_code,
-            0);
+  ASSERT_EQ(preprocess(minimum, "", both).exit_code, 0);
   const CliResult lit = flat_of(both, "flat_both");
   EXPECT_EQ(lit.exit_code, 0) << lit.err;
 }
